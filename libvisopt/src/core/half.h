@@ -1,0 +1,47 @@
+// The 16-bit storage type: the same 16 bits on host and device, converted at load and store.
+// nvcc crashes on _Float16 in device code, so device (and any nvcc-compiled) code converts with
+// cuda_fp16's intrinsics; plain g++ uses _Float16, a single F16C instruction with -march=native.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+#include "core/hd.h"
+
+#if defined(__CUDACC__)
+#include <cuda_fp16.h>
+#endif
+
+namespace visopt {
+
+struct Half {
+  uint16_t bits;
+};
+
+VISOPT_HD inline float halfToFloat(Half h) {
+#if defined(__CUDACC__)
+  __half_raw raw;
+  raw.x = h.bits;
+  return __half2float(__half(raw));
+#else
+  _Float16 f;
+  std::memcpy(&f, &h.bits, 2);
+  return static_cast<float>(f);
+#endif
+}
+
+// Round to nearest even; values beyond fp16's range become +-inf, which callers avoid by
+// storing normalised or bounded quantities only.
+VISOPT_HD inline Half floatToHalf(float v) {
+#if defined(__CUDACC__)
+  __half_raw raw = __half_raw(__float2half_rn(v));
+  return Half{raw.x};
+#else
+  _Float16 f = static_cast<_Float16>(v);
+  Half h;
+  std::memcpy(&h.bits, &f, 2);
+  return h;
+#endif
+}
+
+}  // namespace visopt

@@ -1,0 +1,15 @@
+// VISOPT_HD marks code callable from host and device. Under nvcc it expands to
+// __host__ __device__; under a plain C++ compiler to nothing. Internal only: the public headers
+// never name CUDA.
+#pragma once
+
+#if defined(__CUDACC__)
+#define VISOPT_HD __host__ __device__
+#define VISOPT_DEVICE_COMPILE 1
+#else
+#define VISOPT_HD
+#endif
+
+#if defined(__CUDA_ARCH__)
+#define VISOPT_ON_DEVICE 1
+#endif

@@ -1,0 +1,108 @@
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <new>
+#include <string>
+
+#include <tbb/info.h>
+
+#include "exec/cuda_runtime.h"
+#include "exec/parallel.h"
+#include "visopt/error.h"
+
+namespace visopt {
+
+namespace {
+
+Backend decideBackend() {
+  const char* env = std::getenv("VISOPT_BACKEND");
+  const bool forceCpu = env && std::string(env) == "cpu";
+  if (cudaCompiledIn() && !forceCpu) {
+    std::string why;
+    if (exec::cudaDeviceAnswers(why)) return Backend::CUDA;
+    std::fprintf(stderr, "visopt: no CUDA device answers (%s); using the CPU backend\n",
+                 why.c_str());
+  } else if (!cudaCompiledIn()) {
+    std::fprintf(stderr, "visopt: built without CUDA; using the CPU backend\n");
+  }
+  return Backend::CPU;
+}
+
+struct TimingRegistry {
+  std::mutex mutex;
+  std::map<std::string, StageTiming> stages;
+};
+
+TimingRegistry& registry() {
+  static TimingRegistry r;
+  return r;
+}
+
+}  // namespace
+
+bool cudaCompiledIn() {
+#if defined(VISOPT_WITH_CUDA)
+  return true;
+#else
+  return false;
+#endif
+}
+
+Backend activeBackend() {
+  static const Backend backend = decideBackend();
+  return backend;
+}
+
+std::string backendDescription() {
+  if (activeBackend() == Backend::CUDA) return "CUDA (" + exec::cudaDeviceName() + ")";
+  return "CPU (oneTBB, " + std::to_string(tbb::info::default_concurrency()) + " threads)";
+}
+
+std::vector<StageTiming> stageTimings() {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  std::vector<StageTiming> out;
+  for (auto& [name, t] : r.stages) out.push_back(t);
+  return out;
+}
+
+void resetStageTimings() {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  r.stages.clear();
+}
+
+namespace exec {
+
+void recordLaunch(const char* name, double ms, double items) {
+  auto& r = registry();
+  std::lock_guard lock(r.mutex);
+  auto& t = r.stages[name];
+  t.name = name;
+  t.totalMs += ms;
+  t.calls += 1;
+  t.items += items;
+}
+
+void* allocate(size_t bytes) {
+  if (bytes == 0) bytes = 1;
+  if (activeBackend() == Backend::CUDA) return cudaAllocateManaged(bytes);
+  void* p = std::aligned_alloc(64, (bytes + 63) / 64 * 64);
+  if (!p)
+    throw Error(ErrorKind::Failure,
+                "out of memory allocating " + std::to_string(bytes >> 20) + " MiB");
+  return p;
+}
+
+void deallocate(void* p) {
+  if (!p) return;
+  if (activeBackend() == Backend::CUDA)
+    cudaFreeManaged(p);
+  else
+    std::free(p);
+}
+
+}  // namespace exec
+}  // namespace visopt

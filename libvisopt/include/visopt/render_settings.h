@@ -1,0 +1,47 @@
+// How an image is rendered: single scattering of one point light (paper 000 Eqs. 6-9).
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace visopt {
+
+struct RenderSettings {
+  int width = 512, height = 512;
+  // Ray-marching step, in units of the smallest voxel spacing. Each pixel's samples are
+  // stratified with a per-pixel random offset (jitter) against wood-grain artefacts.
+  float stepFactor = 0.5f;
+  bool jitter = true;
+  uint32_t seed = 1;
+  // Preview: render at 1/previewFactor of the size with twice the step, then upscale.
+  bool preview = false;
+  int previewFactor = 4;
+
+  // Phase function: a blend of Henyey-Greenstein (anisotropy hgAnisotropy) and normalised
+  // Blinn-Phong about the scalar gradient; the blend weight grows with the gradient magnitude
+  // (per voxel, in normalised units) up to `surfaceGradient` where shading is all Blinn-Phong.
+  float hgAnisotropy = 0.1f;
+  float diffuse = 0.9f, specular = 0.25f, shininess = 40.f;
+  float surfaceGradient = 0.04f;
+  // Unshadowed ambient light in-scattered isotropically; 0 for pure single scattering.
+  float ambient = 0.12f;
+  glm::vec3 background{0.06f, 0.065f, 0.075f};
+  float exposure = 1.f;
+
+  // Light-space frustum grid for T_L (paper 000 Eq. 5): rays per side, depth cells (0 = one per
+  // voxel along the volume's diagonal).
+  int lightGridSize = 192;
+  int lightGridDepth = 0;
+  // Stop marching once the view transmittance drops below this.
+  float earlyStop = 1e-4f;
+};
+
+struct RenderStats {
+  double milliseconds = 0.0;
+  double lightMilliseconds = 0.0;  // T_L update, when it ran
+  int64_t samples = 0;             // volume samples taken
+  int width = 0, height = 0;       // actual rendered resolution (smaller in preview)
+};
+
+}  // namespace visopt

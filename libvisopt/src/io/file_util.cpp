@@ -1,0 +1,182 @@
+#include "io/file_util.h"
+
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "visopt/error.h"
+
+namespace visopt::io {
+
+namespace fs = std::filesystem;
+
+bool endsWithNoCase(std::string_view text, std::string_view suffix) {
+  if (suffix.size() > text.size()) return false;
+  return std::equal(suffix.begin(), suffix.end(), text.end() - std::ptrdiff_t(suffix.size()),
+                    [](char a, char b) {
+                      return std::tolower(static_cast<unsigned char>(a)) ==
+                             std::tolower(static_cast<unsigned char>(b));
+                    });
+}
+
+std::string fileName(const std::string& path) {
+  fs::path p(path);
+  if (!p.has_filename()) p = p.parent_path();
+  return p.filename().string();
+}
+
+std::string parentDir(const std::string& path) {
+  fs::path parent = fs::path(path).parent_path();
+  return parent.empty() ? std::string(".") : parent.string();
+}
+
+std::string siblingPath(const std::string& headerPath, const std::string& name) {
+  fs::path p(name);
+  if (p.is_absolute()) return name;
+  return (fs::path(parentDir(headerPath)) / p).string();
+}
+
+uint64_t checkedFileSize(const std::string& path) {
+  std::error_code ec;
+  fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) throwBadInput(path, "file not found");
+  if (fs::is_directory(status)) throwBadInput(path, "is a folder, not a file");
+  uint64_t size = fs::file_size(path, ec);
+  if (ec) throwBadInput(path, "cannot read file size (" + ec.message() + ")");
+  if (size == 0) throwBadInput(path, "file is empty");
+  return size;
+}
+
+bool hostIsBigEndian() { return std::endian::native == std::endian::big; }
+
+void swapBytesInPlace(void* data, size_t count, size_t elementSize) {
+  if (elementSize <= 1) return;
+  auto* bytes = static_cast<unsigned char*>(data);
+  for (size_t i = 0; i < count; ++i) std::reverse(bytes + i * elementSize, bytes + (i + 1) * elementSize);
+}
+
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+FilePtr openAt(const std::string& path, uint64_t offset) {
+  FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) throwBadInput(path, std::string("cannot open: ") + std::strerror(errno));
+  if (offset > uint64_t(std::numeric_limits<long>::max()) ||
+      std::fseek(file.get(), static_cast<long>(offset), SEEK_SET) != 0)
+    throwBadInput(path, "cannot seek to data offset " + std::to_string(offset));
+  return file;
+}
+
+std::string sizeText(uint64_t bytes) { return std::to_string(bytes) + " bytes"; }
+
+ScalarData makeScalarData(std::shared_ptr<unsigned char[]> buffer, ScalarType type, size_t count) {
+  ScalarData out;
+  out.type = type;
+  out.count = count;
+  out.data = buffer.get();
+  out.owner = std::shared_ptr<const void>(buffer, buffer.get());
+  return out;
+}
+
+}  // namespace
+
+ScalarData readPayload(const std::string& path, uint64_t offset, ScalarType type, size_t count,
+                       bool bigEndian) {
+  const uint64_t fileSize = checkedFileSize(path);
+  const size_t elementSize = scalarTypeSize(type);
+  const uint64_t need = uint64_t(count) * elementSize;  // caller checked overflow via checkHeader
+  if (offset > fileSize || fileSize - offset < need)
+    throwBadInput(path, "truncated: header describes " + sizeText(need) + " of data after offset " +
+                            std::to_string(offset) + ", file has only " +
+                            sizeText(offset > fileSize ? 0 : fileSize - offset));
+  auto buffer = std::make_shared_for_overwrite<unsigned char[]>(std::max<size_t>(need, 1));
+  FilePtr file = openAt(path, offset);
+  if (need > 0 && std::fread(buffer.get(), 1, need, file.get()) != need)
+    throwBadInput(path, "truncated: could not read " + sizeText(need) + " of data");
+  if (bigEndian != hostIsBigEndian()) swapBytesInPlace(buffer.get(), count, elementSize);
+  return makeScalarData(std::move(buffer), type, count);
+}
+
+ScalarData readCompressedPayload(const std::string& path, uint64_t offset, ScalarType type,
+                                 size_t count, bool bigEndian) {
+  const uint64_t fileSize = checkedFileSize(path);
+  if (offset >= fileSize) throwBadInput(path, "truncated: no compressed data after the header");
+  const size_t elementSize = scalarTypeSize(type);
+  const size_t need = count * elementSize;
+  auto buffer = std::make_shared_for_overwrite<unsigned char[]>(std::max<size_t>(need, 1));
+
+  FilePtr file = openAt(path, offset);
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 32) != Z_OK)  // 15 + 32: accept zlib or gzip headers
+    throwBadInput(path, "cannot initialise zlib");
+  std::vector<unsigned char> in(1 << 16);
+  size_t produced = 0;
+  int rc = Z_OK;
+  bool eof = false;
+  while (produced < need && rc != Z_STREAM_END) {
+    if (zs.avail_in == 0 && !eof) {
+      size_t got = std::fread(in.data(), 1, in.size(), file.get());
+      if (got == 0) eof = true;
+      zs.next_in = in.data();
+      zs.avail_in = static_cast<uInt>(got);
+    }
+    if (zs.avail_in == 0 && eof) break;
+    size_t chunk = std::min<size_t>(need - produced, size_t(1) << 30);
+    zs.next_out = buffer.get() + produced;
+    zs.avail_out = static_cast<uInt>(chunk);
+    rc = inflate(&zs, Z_NO_FLUSH);
+    produced += chunk - zs.avail_out;
+    if (rc == Z_NEED_DICT || rc == Z_DATA_ERROR || rc == Z_MEM_ERROR) {
+      inflateEnd(&zs);
+      throwBadInput(path, "corrupt compressed data (zlib: " +
+                              std::string(zs.msg ? zs.msg : "data error") + ")");
+    }
+  }
+  inflateEnd(&zs);
+  if (produced < need)
+    throwBadInput(path, "truncated: compressed data inflates to " + sizeText(produced) +
+                            ", header describes " + sizeText(need));
+  if (bigEndian != hostIsBigEndian()) swapBytesInPlace(buffer.get(), count, elementSize);
+  return makeScalarData(std::move(buffer), type, count);
+}
+
+std::string makeTemporarySibling(const std::string& path, const std::string& suffix) {
+  std::string pattern = path + ".tmp-XXXXXX" + suffix;
+  std::vector<char> name(pattern.begin(), pattern.end());
+  name.push_back('\0');
+  int fd = mkstemps(name.data(), static_cast<int>(suffix.size()));
+  if (fd < 0)
+    throw Error(ErrorKind::Failure,
+                path + ": cannot create a temporary file next to it: " + std::strerror(errno));
+  ::close(fd);
+  return std::string(name.data());
+}
+
+void commitTemporary(const std::string& temporary, const std::string& path) {
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    int err = errno;
+    discardTemporary(temporary);
+    throw Error(ErrorKind::Failure, path + ": cannot move the written file into place: " +
+                                        std::strerror(err));
+  }
+}
+
+void discardTemporary(const std::string& temporary) noexcept { std::remove(temporary.c_str()); }
+
+}  // namespace visopt::io

@@ -1,0 +1,118 @@
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "exec/parallel.h"
+#include "kernels/ray_march.h"
+#include "kernels/transmittance_scan.h"
+#include "kernels/volume_extinction.h"
+#include "visopt/error.h"
+
+namespace visopt {
+
+namespace {
+
+TransferLookup lookupOf(const RenderScene& scene) {
+  return TransferLookup{scene.transfer->data(), int(scene.transfer->size())};
+}
+
+VolumeExtinction extinctionOf(const RenderScene& scene) {
+  VolumeExtinction e;
+  e.volume = GridMap(scene.volume->grid());
+  e.scalars = FieldView(scene.volume->normalized);
+  if (scene.extinction) e.extinction = FieldView(*scene.extinction);
+  e.transfer = lookupOf(scene);
+  return e;
+}
+
+// Bilinear upscaling of a preview image to the requested size.
+Image upscale(const Image& small, int width, int height) {
+  Image out(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      float sx = std::clamp((float(x) + 0.5f) * float(small.width) / float(width) - 0.5f, 0.f,
+                            float(small.width - 1));
+      float sy = std::clamp((float(y) + 0.5f) * float(small.height) / float(height) - 0.5f, 0.f,
+                            float(small.height - 1));
+      int x0 = int(sx), y0 = int(sy);
+      int x1 = std::min(x0 + 1, small.width - 1), y1 = std::min(y0 + 1, small.height - 1);
+      float fx = sx - float(x0), fy = sy - float(y0);
+      glm::vec3 a = glm::mix(small.at(x0, y0), small.at(x1, y0), fx);
+      glm::vec3 b = glm::mix(small.at(x0, y1), small.at(x1, y1), fx);
+      out.at(x, y) = glm::mix(a, b, fy);
+    }
+  return out;
+}
+
+}  // namespace
+
+void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
+                               Field3D& out) {
+  if (out.grid().dims != lightFrustum.dims)
+    throw Error(ErrorKind::Failure, "light transmittance field does not match its frustum");
+  TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum), FieldView(out),
+                                           extinctionOf(scene), true};
+  exec::parallelFor("light transmittance", int64_t(lightFrustum.dims.x) * lightFrustum.dims.y,
+                    scan);
+}
+
+Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats) {
+  if (!scene.volume || !scene.transfer) throw Error(ErrorKind::Usage, "nothing to render");
+  if (settings.width <= 0 || settings.height <= 0 || settings.width > 16384 ||
+      settings.height > 16384)
+    throw Error(ErrorKind::Usage, "image size must be between 1 and 16384 pixels per side");
+  if (!(settings.stepFactor > 0.f)) throw Error(ErrorKind::Usage, "step factor must be positive");
+  const auto start = std::chrono::steady_clock::now();
+  const bool preview = settings.preview && settings.previewFactor > 1;
+  const int w = preview ? std::max(1, settings.width / settings.previewFactor) : settings.width;
+  const int h = preview ? std::max(1, settings.height / settings.previewFactor) : settings.height;
+
+  const GridSpec& grid = scene.volume->grid();
+  RayMarchParams p;
+  p.camera = FrustumMap(FrustumGrid::forCamera(scene.camera, w, h, grid.worldBounds(), 1, 1.f));
+  p.volume = GridMap(grid);
+  p.scalars = FieldView(scene.volume->normalized);
+  if (scene.extinction) p.extinction = FieldView(*scene.extinction);
+  p.transfer = lookupOf(scene);
+  if (scene.lightTransmittance && scene.lightFrustum) {
+    p.light = FrustumMap(*scene.lightFrustum);
+    p.lightTransmittance = FieldView(*scene.lightTransmittance);
+  }
+  p.lightPosition = scene.light.position;
+  p.lightRadiance = scene.light.intensity * scene.light.color;
+  p.step = settings.stepFactor * grid.minSpacing() * (preview ? 2.f : 1.f);
+  p.jitter = settings.jitter;
+  p.seed = settings.seed;
+  p.hg = std::clamp(settings.hgAnisotropy, -0.99f, 0.99f);
+  p.kd = settings.diffuse;
+  p.ks = settings.specular;
+  p.shininess = settings.shininess;
+  p.surfaceGradient = std::max(settings.surfaceGradient, 1e-6f);
+  p.ambient = settings.ambient;
+  p.background = settings.background;
+  p.earlyStop = settings.earlyStop;
+
+  DeviceBuffer<glm::vec3> pixels(size_t(w) * size_t(h));
+  p.pixels = pixels.data();
+  RayMarchKernel kernel{p};
+  const int64_t samples = exec::reduce(
+      "render", int64_t(w) * h, int64_t(0), kernel,
+      [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+
+  Image image(w, h);
+  for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = pixels[i] * settings.exposure;
+  if (preview) image = upscale(image, settings.width, settings.height);
+  if (stats) {
+    stats->milliseconds =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats->samples = samples;
+    stats->width = w;
+    stats->height = h;
+  }
+  return image;
+}
+
+}  // namespace visopt

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -50,9 +51,17 @@ bool cudaCompiledIn() {
 #endif
 }
 
-Backend activeBackend() {
+namespace {
+std::atomic<int> backendOverride{-1};
+Backend processBackend() {
   static const Backend backend = decideBackend();
   return backend;
+}
+}  // namespace
+
+Backend activeBackend() {
+  int forced = backendOverride.load(std::memory_order_relaxed);
+  return forced >= 0 ? static_cast<Backend>(forced) : processBackend();
 }
 
 std::string backendDescription() {
@@ -76,6 +85,18 @@ void resetStageTimings() {
 
 namespace exec {
 
+namespace {
+Backend checkedBackend(Backend b) {
+  if (b == Backend::CUDA && processBackend() != Backend::CUDA)
+    throw Error(ErrorKind::Usage, "the CUDA backend is not available");
+  return b;
+}
+}  // namespace
+
+ScopedBackend::ScopedBackend(Backend b)
+    : previous_(backendOverride.exchange(static_cast<int>(checkedBackend(b)))) {}
+ScopedBackend::~ScopedBackend() { backendOverride.store(previous_); }
+
 void recordLaunch(const char* name, double ms, double items) {
   auto& r = registry();
   std::lock_guard lock(r.mutex);
@@ -88,7 +109,8 @@ void recordLaunch(const char* name, double ms, double items) {
 
 void* allocate(size_t bytes) {
   if (bytes == 0) bytes = 1;
-  if (activeBackend() == Backend::CUDA) return cudaAllocateManaged(bytes);
+  // Managed memory whenever a device answers, so either backend can touch it.
+  if (processBackend() == Backend::CUDA) return cudaAllocateManaged(bytes);
   void* p = std::aligned_alloc(64, (bytes + 63) / 64 * 64);
   if (!p)
     throw Error(ErrorKind::Failure,
@@ -98,7 +120,7 @@ void* allocate(size_t bytes) {
 
 void deallocate(void* p) {
   if (!p) return;
-  if (activeBackend() == Backend::CUDA)
+  if (processBackend() == Backend::CUDA)
     cudaFreeManaged(p);
   else
     std::free(p);

@@ -26,6 +26,19 @@ void deallocate(void* p);
 
 void recordLaunch(const char* name, double ms, double items);
 
+// Runs launches on a chosen backend for the lifetime of this object (the parity test compares
+// CPU and CUDA in one process). Memory from allocate() is reachable from both.
+class ScopedBackend {
+ public:
+  explicit ScopedBackend(Backend b);
+  ~ScopedBackend();
+  ScopedBackend(const ScopedBackend&) = delete;
+  ScopedBackend& operator=(const ScopedBackend&) = delete;
+
+ private:
+  int previous_;
+};
+
 class LaunchTimer {
  public:
   LaunchTimer(const char* name, double items)

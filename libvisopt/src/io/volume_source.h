@@ -34,6 +34,9 @@ struct ScalarData {
   ScalarType type = ScalarType::Float32;
   const void* data = nullptr;
   size_t count = 0;
+  // Stored values map to physical ones as value = slope * stored + intercept (NIfTI scl_*,
+  // DICOM rescale); the identity for most formats.
+  double slope = 1.0, intercept = 0.0;
   std::shared_ptr<const void> owner;  // keeps `data` alive (a buffer or a VTK object)
 };
 

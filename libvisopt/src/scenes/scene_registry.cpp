@@ -1,0 +1,52 @@
+// Names, descriptions and dispatch of the built-in scenes.
+#include <string>
+#include <vector>
+
+#include "scenes/scene_makers.h"
+#include "visopt/error.h"
+
+namespace visopt {
+
+namespace {
+
+struct Entry {
+  const char* name;
+  const char* description;
+  BuiltinScene (*make)(int, Precision, MemoryLedger*);
+};
+
+const Entry kScenes[] = {
+    {"shepp-logan",
+     "3D Shepp-Logan head phantom: an opaque outer shell hides the tumours marked important",
+     &scenes::makeSheppLogan},
+    {"marschner-lobb", "Marschner-Lobb test signal (fM = 6, alpha = 0.25) on [-1, 1]^3",
+     &scenes::makeMarschnerLobb},
+    {"earth-mantle",
+     "Earth-like sphere: opaque crust, hot core, cold slabs in the mantle marked important",
+     &scenes::makeEarthMantle},
+    {"mixer", "Stirred tank: wall, rod and paddle around vortex tubes marked important",
+     &scenes::makeMixer},
+    {"hydrogen", "Hydrogen 3d_z2 orbital density: lobes marked important, torus as context",
+     &scenes::makeHydrogen},
+};
+
+}  // namespace
+
+std::vector<SceneDescription> builtinScenes() {
+  std::vector<SceneDescription> out;
+  for (const Entry& e : kScenes) out.push_back(SceneDescription{e.name, e.description});
+  return out;
+}
+
+std::string defaultSceneName() { return "shepp-logan"; }
+
+BuiltinScene makeBuiltinScene(const std::string& name, int resolution, Precision precision,
+                              MemoryLedger* ledger) {
+  for (const Entry& e : kScenes)
+    if (name == e.name) return e.make(resolution, precision, ledger);
+  std::string known;
+  for (const Entry& e : kScenes) known += (known.empty() ? "" : ", ") + std::string(e.name);
+  throw Error(ErrorKind::Usage, "unknown built-in scene '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace visopt

@@ -28,10 +28,10 @@ struct FieldView {
 
   VISOPT_HD bool valid() const { return data != nullptr; }
   VISOPT_HD size_t size() const { return size_t(dims.x) * size_t(dims.y) * size_t(dims.z); }
-  VISOPT_HD size_t index(int i, int j, int k) const {
+  VISOPT_HD VISOPT_INLINE size_t index(int i, int j, int k) const {
     return (size_t(k) * size_t(dims.y) + size_t(j)) * size_t(dims.x) + size_t(i);
   }
-  VISOPT_HD float load(size_t i) const {
+  VISOPT_HD VISOPT_INLINE float load(size_t i) const {
     return half ? halfToFloat(static_cast<const Half*>(data)[i]) : static_cast<const float*>(data)[i];
   }
   VISOPT_HD void store(size_t i, float v) const {
@@ -40,10 +40,10 @@ struct FieldView {
     else
       static_cast<float*>(data)[i] = v;
   }
-  VISOPT_HD float at(int i, int j, int k) const { return load(index(i, j, k)); }
+  VISOPT_HD VISOPT_INLINE float at(int i, int j, int k) const { return load(index(i, j, k)); }
 
   // Trilinear interpolation at continuous index coordinates p, clamped to the grid.
-  VISOPT_HD float sample(glm::vec3 p) const {
+  VISOPT_HD VISOPT_INLINE float sample(glm::vec3 p) const {
     p = glm::clamp(p, glm::vec3(0.f), glm::vec3(dims - 1));
     glm::ivec3 i0 = glm::ivec3(p);
     glm::ivec3 i1 = glm::min(i0 + 1, dims - 1);

@@ -10,6 +10,13 @@
 #define VISOPT_HD
 #endif
 
+// Hot sampling helpers must inline into the ray-marching loops.
+#if defined(__CUDACC__)
+#define VISOPT_INLINE __forceinline__
+#else
+#define VISOPT_INLINE inline __attribute__((always_inline))
+#endif
+
 #if defined(__CUDA_ARCH__)
 #define VISOPT_ON_DEVICE 1
 #endif

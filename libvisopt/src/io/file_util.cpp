@@ -59,12 +59,15 @@ uint64_t checkedFileSize(const std::string& path) {
   return size;
 }
 
-bool hostIsBigEndian() { return std::endian::native == std::endian::big; }
+bool hostIsBigEndian() {
+  return std::endian::native == std::endian::big;
+}
 
 void swapBytesInPlace(void* data, size_t count, size_t elementSize) {
   if (elementSize <= 1) return;
   auto* bytes = static_cast<unsigned char*>(data);
-  for (size_t i = 0; i < count; ++i) std::reverse(bytes + i * elementSize, bytes + (i + 1) * elementSize);
+  for (size_t i = 0; i < count; ++i)
+    std::reverse(bytes + i * elementSize, bytes + (i + 1) * elementSize);
 }
 
 namespace {
@@ -83,7 +86,9 @@ FilePtr openAt(const std::string& path, uint64_t offset) {
   return file;
 }
 
-std::string sizeText(uint64_t bytes) { return std::to_string(bytes) + " bytes"; }
+std::string sizeText(uint64_t bytes) {
+  return std::to_string(bytes) + " bytes";
+}
 
 ScalarData makeScalarData(std::shared_ptr<unsigned char[]> buffer, ScalarType type, size_t count) {
   ScalarData out;
@@ -172,11 +177,13 @@ void commitTemporary(const std::string& temporary, const std::string& path) {
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     int err = errno;
     discardTemporary(temporary);
-    throw Error(ErrorKind::Failure, path + ": cannot move the written file into place: " +
-                                        std::strerror(err));
+    throw Error(ErrorKind::Failure,
+                path + ": cannot move the written file into place: " + std::strerror(err));
   }
 }
 
-void discardTemporary(const std::string& temporary) noexcept { std::remove(temporary.c_str()); }
+void discardTemporary(const std::string& temporary) noexcept {
+  std::remove(temporary.c_str());
+}
 
 }  // namespace visopt::io

@@ -9,7 +9,18 @@
 
 namespace visopt::io {
 
-enum class ScalarType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Float32, Float64 };
+enum class ScalarType {
+  Int8,
+  UInt8,
+  Int16,
+  UInt16,
+  Int32,
+  UInt32,
+  Int64,
+  UInt64,
+  Float32,
+  Float64
+};
 
 const char* scalarTypeName(ScalarType type);
 size_t scalarTypeSize(ScalarType type);
@@ -20,16 +31,26 @@ std::optional<ScalarType> parseScalarTypeName(const std::string& name);
 template <class F>
 decltype(auto) visitScalarType(ScalarType type, F&& f) {
   switch (type) {
-    case ScalarType::Int8: return f(int8_t{});
-    case ScalarType::UInt8: return f(uint8_t{});
-    case ScalarType::Int16: return f(int16_t{});
-    case ScalarType::UInt16: return f(uint16_t{});
-    case ScalarType::Int32: return f(int32_t{});
-    case ScalarType::UInt32: return f(uint32_t{});
-    case ScalarType::Int64: return f(int64_t{});
-    case ScalarType::UInt64: return f(uint64_t{});
-    case ScalarType::Float32: return f(float{});
-    case ScalarType::Float64: break;
+    case ScalarType::Int8:
+      return f(int8_t{});
+    case ScalarType::UInt8:
+      return f(uint8_t{});
+    case ScalarType::Int16:
+      return f(int16_t{});
+    case ScalarType::UInt16:
+      return f(uint16_t{});
+    case ScalarType::Int32:
+      return f(int32_t{});
+    case ScalarType::UInt32:
+      return f(uint32_t{});
+    case ScalarType::Int64:
+      return f(int64_t{});
+    case ScalarType::UInt64:
+      return f(uint64_t{});
+    case ScalarType::Float32:
+      return f(float{});
+    case ScalarType::Float64:
+      break;
   }
   return f(double{});
 }

@@ -28,12 +28,10 @@ LoadedVolume loadAnyVolume(const std::string& path, const ProgressCallback& prog
     LoadedVolume (*read)(const std::string&, const ProgressCallback&);
   };
   static const Entry entries[] = {
-      {".nii", io::readNifti},         {".nii.gz", io::readNifti},
-      {".mha", io::readMetaImage},     {".mhd", io::readMetaImage},
-      {".vti", io::readVtkXmlImage},   {".vtk", io::readVtkLegacy},
-      {".nrrd", io::readNrrd},         {".nhdr", io::readNrrd},
-      {".raw", io::readRawWithSidecar}, {".inr", io::readInrimage},
-      {".plt", io::readGOpenMolPlt},
+      {".nii", io::readNifti},     {".nii.gz", io::readNifti},    {".mha", io::readMetaImage},
+      {".mhd", io::readMetaImage}, {".vti", io::readVtkXmlImage}, {".vtk", io::readVtkLegacy},
+      {".nrrd", io::readNrrd},     {".nhdr", io::readNrrd},       {".raw", io::readRawWithSidecar},
+      {".inr", io::readInrimage},  {".plt", io::readGOpenMolPlt},
   };
   for (const Entry& e : entries)
     if (io::endsWithNoCase(path, e.suffix)) return e.read(path, progress);

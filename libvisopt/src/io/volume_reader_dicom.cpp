@@ -1,21 +1,34 @@
-// A DICOM series given as a folder, through vtkDICOMImageReader (uncompressed transfer syntaxes
-// only; one series per folder). The reader sorts the slices by position and flips the rows so
-// that row 0 is the bottom one; geometry is rebuilt in DICOM patient space (LPS):
-//   direction columns: row direction (IOP[0..2]), column direction (IOP[3..5]) flipped to match
-//   the row flip, and their cross product for the slices;
-//   origin: the world position of voxel (0,0,0) after the flip.
-// Rescale slope/intercept are applied to the values.
+// A DICOM series given as a folder (uncompressed transfer syntaxes, one series per folder).
+// Each file is opened with vtkDICOMImageReader on its own, so the slice geometry is ours to
+// check: every slice must have the same size, type, pixel spacing and orientation; slices are
+// sorted by their position along the normal (row x column direction) and must be evenly
+// spaced. Geometry is DICOM patient space (LPS):
+//   vtkDICOMImageReader stores each slice bottom row first, so index j runs against the DICOM
+//   column direction: direction = (row, -column, normal), origin = the position of the first
+//   slice's bottom-left pixel.
+// The reader applies the rescale slope/intercept itself. It also takes the first value of
+// PixelSpacing (the spacing between rows, along j) as the x spacing; the DICOM meaning is
+// restored here.
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include <vtkDICOMImageReader.h>
 #include <vtkImageData.h>
+#include <vtkInformation.h>
 #include <vtkNew.h>
+#include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 
 #include "io/file_util.h"
 #include "io/vtk_image_reading.h"
+#include "io/vtk_quiet.h"
 #include "visopt/error.h"
 
 namespace visopt::io {
@@ -35,58 +48,174 @@ class CerrSilencer {
   std::streambuf* previous_;
 };
 
+struct Slice {
+  std::string file;
+  int width = 0, height = 0;
+  double spacing[2] = {1, 1};  // along i (columns), along j (rows)
+  double row[3] = {1, 0, 0}, col[3] = {0, 1, 0};
+  double position[3] = {0, 0, 0};
+  double along = 0;  // position . normal
+};
+
+// vtkDICOMImageReader reads short pixel data without complaint: find the last PixelData element
+// (7FE0,0010) and check that the length it declares is present in the file.
+void checkPixelData(const std::string& folder, const std::string& file, size_t minBytes) {
+  const uint64_t size = checkedFileSize(file);
+  std::ifstream in(file, std::ios::binary);
+  // Headers are small: the element sits in the first 64 KiB.
+  std::string tail(static_cast<size_t>(std::min<uint64_t>(size, 1 << 16)), '\0');
+  in.read(tail.data(), std::streamsize(tail.size()));
+  const std::string tag("\xE0\x7F\x10\x00", 4);
+  size_t at = tail.rfind(tag);
+  if (at == std::string::npos) throwBadInput(folder, fileName(file) + ": no pixel data");
+  uint64_t lengthAt = 0, dataAt = 0;
+  if (at + 8 <= tail.size() &&
+      (tail.compare(at + 4, 2, "OW") == 0 || tail.compare(at + 4, 2, "OB") == 0)) {
+    lengthAt = at + 8;
+    dataAt = at + 12;
+  } else {
+    lengthAt = at + 4;
+    dataAt = at + 8;
+  }
+  if (lengthAt + 4 > tail.size()) throwBadInput(folder, fileName(file) + ": truncated pixel data");
+  uint32_t length = 0;
+  std::memcpy(&length, tail.data() + lengthAt, 4);
+  if (length == 0xFFFFFFFFu)
+    throwBadInput(folder, fileName(file) + ": compressed (encapsulated) DICOM is not supported");
+  if (dataAt + length > size || length < minBytes)
+    throwBadInput(folder, fileName(file) + ": truncated pixel data (" + std::to_string(length) +
+                              " bytes declared, " + std::to_string(size - std::min(size, dataAt)) +
+                              " present)");
+}
+
+double dot(const double a[3], const double b[3]) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+bool near(double a, double b, double tol) {
+  return std::abs(a - b) <= tol * std::max(1.0, std::abs(a));
+}
+
 }  // namespace
 
 LoadedVolume readDicomSeries(const std::string& path, const ProgressCallback& progress) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  size_t files = 0;
+  std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(path, ec))
-    if (entry.is_regular_file(ec)) ++files;
+    if (entry.is_regular_file(ec)) files.push_back(entry.path().string());
   if (ec) throwBadInput(path, "cannot list the folder (" + ec.message() + ")");
-  if (files == 0) throwBadInput(path, "folder holds no files (expected a DICOM series)");
+  if (files.empty()) throwBadInput(path, "folder holds no files (expected a DICOM series)");
+  std::sort(files.begin(), files.end());
 
   CerrSilencer silence;
-  vtkNew<vtkDICOMImageReader> reader;
-  reader->SetDirectoryName(path.c_str());
-  VtkImageRead read = runVtkImageReader(path, reader, progress);
-  VolumeHeader h = headerFromVtkImage(read);
-
-  const float* iop = reader->GetImageOrientationPatient();
-  const float* ipp = reader->GetImagePositionPatient();
-  double row[3] = {1, 0, 0}, col[3] = {0, 1, 0};
-  if (iop) {
+  std::vector<Slice> slices;
+  for (const std::string& file : files) {
+    vtkNew<vtkDICOMImageReader> reader;
+    VtkErrorCapture capture(reader);
+    if (!reader->CanReadFile(file.c_str())) continue;  // DICOMDIR-less extras, notes, ...
+    reader->SetFileName(file.c_str());
+    reader->UpdateInformation();
+    if (capture.error() || reader->GetErrorCode() != 0)
+      throwBadInput(path, fileName(file) + ": cannot read the DICOM header" +
+                              (capture.error() ? ": " + *capture.error() : std::string()));
+    int extent[6];
+    reader->GetOutputInformation(0)->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent);
+    Slice s;
+    s.file = file;
+    s.width = extent[1] - extent[0] + 1;
+    s.height = extent[3] - extent[2] + 1;
+    if (extent[5] != extent[4])
+      throwBadInput(path, fileName(file) + ": multi-frame DICOM files are not supported");
+    const double* ps = reader->GetPixelSpacing();
+    s.spacing[0] = ps[1];  // see the note on PixelSpacing above
+    s.spacing[1] = ps[0];
+    const float* iop = reader->GetImageOrientationPatient();
+    const float* ipp = reader->GetImagePositionPatient();
     for (int r = 0; r < 3; ++r) {
-      row[r] = iop[r];
-      col[r] = iop[r + 3];
+      s.row[r] = iop[r];
+      s.col[r] = iop[r + 3];
+      s.position[r] = ipp[r];
+    }
+    const double rl = std::sqrt(dot(s.row, s.row)), cl = std::sqrt(dot(s.col, s.col));
+    if (rl < 0.5 || cl < 0.5) {  // no orientation given: assume axial
+      s.row[0] = 1, s.row[1] = 0, s.row[2] = 0;
+      s.col[0] = 0, s.col[1] = 1, s.col[2] = 0;
+    } else {
+      for (int r = 0; r < 3; ++r) s.row[r] /= rl, s.col[r] /= cl;
+    }
+    slices.push_back(s);
+  }
+  if (slices.empty()) throwBadInput(path, "no DICOM files in the folder");
+
+  const Slice& first = slices.front();
+  double normal[3] = {first.row[1] * first.col[2] - first.row[2] * first.col[1],
+                      first.row[2] * first.col[0] - first.row[0] * first.col[2],
+                      first.row[0] * first.col[1] - first.row[1] * first.col[0]};
+  for (Slice& s : slices) {
+    if (s.width != first.width || s.height != first.height)
+      throwBadInput(path, fileName(s.file) + ": slice size differs from the rest of the series");
+    for (int r = 0; r < 3; ++r)
+      if (!near(s.row[r], first.row[r], 1e-3) || !near(s.col[r], first.col[r], 1e-3))
+        throwBadInput(path, fileName(s.file) + ": slice orientation differs from the series");
+    if (!near(s.spacing[0], first.spacing[0], 1e-4) || !near(s.spacing[1], first.spacing[1], 1e-4))
+      throwBadInput(path, fileName(s.file) + ": pixel spacing differs from the series");
+    s.along = dot(s.position, normal);
+  }
+  std::sort(slices.begin(), slices.end(),
+            [](const Slice& a, const Slice& b) { return a.along < b.along; });
+  double sliceSpacing = 1.0;
+  if (slices.size() > 1) {
+    sliceSpacing = (slices.back().along - slices.front().along) / double(slices.size() - 1);
+    for (size_t s = 1; s < slices.size(); ++s)
+      if (!(slices[s].along - slices[s - 1].along > 1e-6))
+        throwBadInput(path, fileName(slices[s].file) + " and " + fileName(slices[s - 1].file) +
+                                ": two slices at the same position");
+    for (size_t s = 1; s < slices.size(); ++s) {
+      const double gap = slices[s].along - slices[s - 1].along;
+      if (std::abs(gap - sliceSpacing) > 0.01 * sliceSpacing + 1e-4)
+        throwBadInput(path,
+                      "uneven slice spacing (missing slices?) near " + fileName(slices[s].file));
     }
   }
-  double rowLen = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
-  double colLen = std::sqrt(col[0] * col[0] + col[1] * col[1] + col[2] * col[2]);
-  if (rowLen < 0.5 || colLen < 0.5) {  // absent or zero orientation: assume axial
-    row[0] = 1, row[1] = 0, row[2] = 0;
-    col[0] = 0, col[1] = 1, col[2] = 0;
-    rowLen = colLen = 1.0;
-  }
-  double normal[3] = {row[1] * col[2] - row[2] * col[1], row[2] * col[0] - row[0] * col[2],
-                      row[0] * col[1] - row[1] * col[0]};
-  // Rows are stored bottom-up, so the j axis runs against the DICOM column direction.
-  const double ny = double(h.dims[1] - 1) * h.spacing[1];
+
+  VolumeHeader h;
+  h.dims = {first.width, first.height, int64_t(slices.size())};
+  h.spacing = {first.spacing[0], first.spacing[1], sliceSpacing};
+  const double columnRun = double(first.height - 1) * first.spacing[1];
   for (int r = 0; r < 3; ++r) {
-    h.direction[0][size_t(r)] = row[r] / rowLen;
-    h.direction[1][size_t(r)] = -col[r] / colLen;
-    h.direction[2][size_t(r)] = normal[r] / (rowLen * colLen);
-    h.origin[size_t(r)] = (ipp ? double(ipp[r]) : 0.0) + ny * col[r] / colLen;
+    h.direction[0][size_t(r)] = first.row[r];
+    h.direction[1][size_t(r)] = -first.col[r];
+    h.direction[2][size_t(r)] = normal[r];
+    h.origin[size_t(r)] = slices.front().position[r] + columnRun * first.col[r];
   }
   LoadedVolume out;
   out.format = "dicom";
-  out.grid = checkHeader(path, h);
-  out.scalars = read.scalars;
-  const double slope = reader->GetRescaleSlope(), intercept = reader->GetRescaleOffset();
-  if (std::isfinite(slope) && slope != 0.0 && std::isfinite(intercept)) {
-    out.scalars.slope = slope;
-    out.scalars.intercept = intercept;
+  out.grid = checkHeader(path, h);  // before any pixel data is read
+  reportProgress(progress, path, 0.1f, "header");
+
+  const size_t perSlice = size_t(first.width) * size_t(first.height);
+  std::shared_ptr<unsigned char[]> buffer;
+  for (size_t s = 0; s < slices.size(); ++s) {
+    checkPixelData(path, slices[s].file, perSlice);
+    vtkNew<vtkDICOMImageReader> reader;
+    reader->SetFileName(slices[s].file.c_str());
+    VtkImageRead read = runVtkImageReader(path + "/" + fileName(slices[s].file), reader, {});
+    if (read.scalars.count != perSlice)
+      throwBadInput(path, fileName(slices[s].file) + ": truncated pixel data");
+    if (s == 0) {
+      out.scalars.type = read.scalars.type;
+      out.scalars.count = perSlice * slices.size();
+      buffer = std::make_shared_for_overwrite<unsigned char[]>(out.scalars.count *
+                                                               scalarTypeSize(read.scalars.type));
+    } else if (read.scalars.type != out.scalars.type) {
+      throwBadInput(path, fileName(slices[s].file) + ": pixel type differs from the series");
+    }
+    const size_t bytes = perSlice * scalarTypeSize(read.scalars.type);
+    std::memcpy(buffer.get() + s * bytes, read.scalars.data, bytes);
   }
+  out.scalars.data = buffer.get();
+  out.scalars.owner = std::shared_ptr<const void>(buffer, buffer.get());
   return out;
 }
 

@@ -16,12 +16,12 @@ namespace {
 
 std::optional<ScalarType> metaElementType(const std::string& name) {
   static const std::map<std::string, ScalarType> types = {
-      {"MET_CHAR", ScalarType::Int8},        {"MET_UCHAR", ScalarType::UInt8},
-      {"MET_SHORT", ScalarType::Int16},      {"MET_USHORT", ScalarType::UInt16},
-      {"MET_INT", ScalarType::Int32},        {"MET_UINT", ScalarType::UInt32},
-      {"MET_LONG", ScalarType::Int32},       {"MET_ULONG", ScalarType::UInt32},
-      {"MET_LONG_LONG", ScalarType::Int64},  {"MET_ULONG_LONG", ScalarType::UInt64},
-      {"MET_FLOAT", ScalarType::Float32},    {"MET_DOUBLE", ScalarType::Float64},
+      {"MET_CHAR", ScalarType::Int8},       {"MET_UCHAR", ScalarType::UInt8},
+      {"MET_SHORT", ScalarType::Int16},     {"MET_USHORT", ScalarType::UInt16},
+      {"MET_INT", ScalarType::Int32},       {"MET_UINT", ScalarType::UInt32},
+      {"MET_LONG", ScalarType::Int32},      {"MET_ULONG", ScalarType::UInt32},
+      {"MET_LONG_LONG", ScalarType::Int64}, {"MET_ULONG_LONG", ScalarType::UInt64},
+      {"MET_FLOAT", ScalarType::Float32},   {"MET_DOUBLE", ScalarType::Float64},
   };
   auto it = types.find(name);
   if (it == types.end()) return std::nullopt;
@@ -51,8 +51,7 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
     if (trim(line).empty()) continue;
     size_t eq = line.find('=');
     if (eq == std::string::npos)
-      throwBadInput(path, "not a MetaImage header (line without '=': \"" +
-                              trim(line).substr(0, 40) + "\")");
+      throwBadInput(path, "not a MetaImage header (expected 'Key = Value' lines)");
     std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
     fields[key] = value;
     if (key == "ElementDataFile") {
@@ -67,7 +66,8 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
     auto it = fields.find(key);
     if (it == fields.end()) return std::nullopt;
     auto v = parseNumbers(it->second);
-    if (!v || v->size() < n) throwBadInput(path, key + " must hold " + std::to_string(n) + " numbers");
+    if (!v || v->size() < n)
+      throwBadInput(path, key + " must hold " + std::to_string(n) + " numbers");
     v->resize(n);
     return v;
   };
@@ -121,7 +121,8 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
     dataFile = path;
     if (dataOffset > fileSize) throwBadInput(path, "truncated: no data after the header");
   } else {
-    if (dataFile == "LIST" || dataFile.find('%') != std::string::npos || dataFile.find(' ') != std::string::npos)
+    if (dataFile == "LIST" || dataFile.find('%') != std::string::npos ||
+        dataFile.find(' ') != std::string::npos)
       throwBadInput(path, "ElementDataFile \"" + dataFile + "\": file lists are not supported");
     dataFile = siblingPath(path, dataFile);
     dataOffset = 0;

@@ -20,26 +20,46 @@ namespace {
 
 std::optional<ScalarType> nrrdType(std::string name) {
   static const std::map<std::string, ScalarType> types = {
-      {"signed char", ScalarType::Int8},  {"int8", ScalarType::Int8},
-      {"int8_t", ScalarType::Int8},       {"uchar", ScalarType::UInt8},
-      {"unsigned char", ScalarType::UInt8}, {"uint8", ScalarType::UInt8},
-      {"uint8_t", ScalarType::UInt8},     {"short", ScalarType::Int16},
-      {"short int", ScalarType::Int16},   {"signed short", ScalarType::Int16},
-      {"signed short int", ScalarType::Int16}, {"int16", ScalarType::Int16},
-      {"int16_t", ScalarType::Int16},     {"ushort", ScalarType::UInt16},
-      {"unsigned short", ScalarType::UInt16}, {"unsigned short int", ScalarType::UInt16},
-      {"uint16", ScalarType::UInt16},     {"uint16_t", ScalarType::UInt16},
-      {"int", ScalarType::Int32},         {"signed int", ScalarType::Int32},
-      {"int32", ScalarType::Int32},       {"int32_t", ScalarType::Int32},
-      {"uint", ScalarType::UInt32},       {"unsigned int", ScalarType::UInt32},
-      {"uint32", ScalarType::UInt32},     {"uint32_t", ScalarType::UInt32},
-      {"longlong", ScalarType::Int64},    {"long long", ScalarType::Int64},
-      {"long long int", ScalarType::Int64}, {"signed long long", ScalarType::Int64},
-      {"signed long long int", ScalarType::Int64}, {"int64", ScalarType::Int64},
-      {"int64_t", ScalarType::Int64},     {"ulonglong", ScalarType::UInt64},
-      {"unsigned long long", ScalarType::UInt64}, {"unsigned long long int", ScalarType::UInt64},
-      {"uint64", ScalarType::UInt64},     {"uint64_t", ScalarType::UInt64},
-      {"float", ScalarType::Float32},     {"double", ScalarType::Float64},
+      {"signed char", ScalarType::Int8},
+      {"int8", ScalarType::Int8},
+      {"int8_t", ScalarType::Int8},
+      {"uchar", ScalarType::UInt8},
+      {"unsigned char", ScalarType::UInt8},
+      {"uint8", ScalarType::UInt8},
+      {"uint8_t", ScalarType::UInt8},
+      {"short", ScalarType::Int16},
+      {"short int", ScalarType::Int16},
+      {"signed short", ScalarType::Int16},
+      {"signed short int", ScalarType::Int16},
+      {"int16", ScalarType::Int16},
+      {"int16_t", ScalarType::Int16},
+      {"ushort", ScalarType::UInt16},
+      {"unsigned short", ScalarType::UInt16},
+      {"unsigned short int", ScalarType::UInt16},
+      {"uint16", ScalarType::UInt16},
+      {"uint16_t", ScalarType::UInt16},
+      {"int", ScalarType::Int32},
+      {"signed int", ScalarType::Int32},
+      {"int32", ScalarType::Int32},
+      {"int32_t", ScalarType::Int32},
+      {"uint", ScalarType::UInt32},
+      {"unsigned int", ScalarType::UInt32},
+      {"uint32", ScalarType::UInt32},
+      {"uint32_t", ScalarType::UInt32},
+      {"longlong", ScalarType::Int64},
+      {"long long", ScalarType::Int64},
+      {"long long int", ScalarType::Int64},
+      {"signed long long", ScalarType::Int64},
+      {"signed long long int", ScalarType::Int64},
+      {"int64", ScalarType::Int64},
+      {"int64_t", ScalarType::Int64},
+      {"ulonglong", ScalarType::UInt64},
+      {"unsigned long long", ScalarType::UInt64},
+      {"unsigned long long int", ScalarType::UInt64},
+      {"uint64", ScalarType::UInt64},
+      {"uint64_t", ScalarType::UInt64},
+      {"float", ScalarType::Float32},
+      {"double", ScalarType::Float64},
   };
   auto it = types.find(toLower(trim(name)));
   if (it == types.end()) return std::nullopt;
@@ -124,9 +144,8 @@ LoadedVolume readNrrd(const std::string& path, const ProgressCallback& progress)
     for (std::string s; k >> s;) kinds.push_back(toLower(s));
   }
   const bool firstAxisNonSpatial =
-      sizes->size() == 4 ||
-      (!kinds.empty() && kinds[0] != "domain" && kinds[0] != "space" && kinds[0] != "time" &&
-       sizes->size() >= 3);
+      sizes->size() == 4 || (!kinds.empty() && kinds[0] != "domain" && kinds[0] != "space" &&
+                             kinds[0] != "time" && sizes->size() >= 3);
   if (firstAxisNonSpatial) {
     h.components = int((*sizes)[0]);
     first = 1;
@@ -192,7 +211,8 @@ LoadedVolume readNrrd(const std::string& path, const ProgressCallback& progress)
         p = prefix.find('\n', p);
         if (p != std::string::npos) ++p;
       }
-      if (p == std::string::npos) throwBadInput(dataFile, "truncated: fewer lines than \"line skip\"");
+      if (p == std::string::npos)
+        throwBadInput(dataFile, "truncated: fewer lines than \"line skip\"");
       dataOffset = p;
     }
   }

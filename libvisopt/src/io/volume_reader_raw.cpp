@@ -80,8 +80,9 @@ LoadedVolume readRawWithSidecar(const std::string& path, const ProgressCallback&
   VolumeHeader header;
   header.dims = numberArray<3, int64_t>(sidecar, doc, "dims", {0, 0, 0}, true);
   if (!doc.contains("type") || !doc["type"].is_string())
-    throwBadInput(sidecar, "missing \"type\" (int8, uint8, int16, uint16, int32, uint32, float32, "
-                           "float64)");
+    throwBadInput(sidecar,
+                  "missing \"type\" (int8, uint8, int16, uint16, int32, uint32, float32, "
+                  "float64)");
   const std::string typeName = doc["type"].get<std::string>();
   auto type = parseScalarTypeName(typeName);
   if (!type) throwBadInput(sidecar, "unsupported scalar type \"" + typeName + "\"");
@@ -117,7 +118,8 @@ LoadedVolume readRawWithSidecar(const std::string& path, const ProgressCallback&
   out.format = "raw";
   out.grid = checkHeader(sidecar, header);
   reportProgress(progress, path, 0.1f, "header");
-  out.scalars = readPayload(path, uint64_t(headerBytes), header.type, out.grid.voxelCount(), bigEndian);
+  out.scalars =
+      readPayload(path, uint64_t(headerBytes), header.type, out.grid.voxelCount(), bigEndian);
   return out;
 }
 

@@ -38,7 +38,7 @@ LoadedVolume readVtkLegacy(const std::string& path, const ProgressCallback& prog
       throwBadInput(path, "not a legacy VTK STRUCTURED_POINTS file");
   }
   reader->ReadAllScalarsOn();
-  VtkImageRead read = runVtkImageReader(path, reader, progress);
+  VtkImageRead read = runVtkImageReader(path, reader, progress, /*warningsAreErrors=*/true);
   LoadedVolume out;
   out.format = "vtk-legacy";
   out.grid = checkHeader(path, headerFromVtkImage(read));

@@ -37,12 +37,14 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
       throwBadInput(path, "invalid dimensions " + dimsText(h.dims) + " (each must be >= 1)");
   for (int a = 0; a < 3; ++a)
     if (h.dims[a] > std::numeric_limits<int>::max())
-      throwBadInput(path, "dimensions " + dimsText(h.dims) + " too large (overflow: an axis exceeds " +
+      throwBadInput(path, "dimensions " + dimsText(h.dims) +
+                              " too large (overflow: an axis exceeds " +
                               std::to_string(std::numeric_limits<int>::max()) + ")");
   size_t voxels = 1, fp32Bytes = 0;
   for (int a = 0; a < 3; ++a)
     if (__builtin_mul_overflow(voxels, static_cast<size_t>(h.dims[a]), &voxels))
-      throwBadInput(path, "dimensions " + dimsText(h.dims) + " overflow: the voxel count does not fit in 64 bits");
+      throwBadInput(path, "dimensions " + dimsText(h.dims) +
+                              " overflow: the voxel count does not fit in 64 bits");
   if (__builtin_mul_overflow(voxels, sizeof(float), &fp32Bytes))
     throwBadInput(path, "dimensions " + dimsText(h.dims) + " overflow: " + std::to_string(voxels) +
                             " voxels cannot be addressed as fp32");
@@ -51,7 +53,8 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
                             " components per voxel) is not supported; need one scalar per voxel");
   const size_t available = availableMemoryBytes();
   if (fp32Bytes > available)
-    throwBadInput(path, "dimensions " + dimsText(h.dims) + " need " + humanBytes(double(fp32Bytes)) +
+    throwBadInput(path, "dimensions " + dimsText(h.dims) + " need " +
+                            humanBytes(double(fp32Bytes)) +
                             " as fp32, more than the available memory (" +
                             humanBytes(double(available)) + ")");
   for (int a = 0; a < 3; ++a)
@@ -73,8 +76,9 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
       double dot = 0.0;
       for (int r = 0; r < 3; ++r) dot += h.direction[c][r] * h.direction[d][r];
       if (std::abs(dot - (c == d ? 1.0 : 0.0)) > 1e-3)
-        throwBadInput(path, "orientation matrix is not orthonormal (sheared or scaled axes are "
-                            "not supported)");
+        throwBadInput(path,
+                      "orientation matrix is not orthonormal (sheared or scaled axes are "
+                      "not supported)");
     }
 
   GridSpec grid;
@@ -90,7 +94,8 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
 
 void reportProgress(const ProgressCallback& progress, const std::string& path, float fraction,
                     const std::string& stage) {
-  if (progress && !progress(fraction, stage)) throw Error(ErrorKind::Cancelled, path + ": cancelled");
+  if (progress && !progress(fraction, stage))
+    throw Error(ErrorKind::Cancelled, path + ": cancelled");
 }
 
 }  // namespace visopt::io

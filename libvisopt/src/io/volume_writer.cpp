@@ -58,7 +58,8 @@ void writeVti(const Volume& volume, const std::string& path, const std::string& 
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToZLib();
   if (writer->Write() != 1 || capture.error())
-    writeFailure(path, "cannot write VTK XML image data: " + capture.error().value_or("write failed"));
+    writeFailure(path,
+                 "cannot write VTK XML image data: " + capture.error().value_or("write failed"));
 }
 
 void writeNifti(const Volume& volume, const std::string& path, const std::string& tmp) {

@@ -2,8 +2,8 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <sstream>
 #include <vector>
@@ -75,9 +75,8 @@ void writeMetaImage(const Volume& volume, const std::string& path, bool detached
   std::filesystem::path dataPath(path);
   dataPath.replace_extension(".raw");
   writeFile(dataPath.string(), ".raw", [&](std::ofstream& out) { writeValues(out, volume); });
-  writeFile(path, ".mhd", [&](std::ofstream& out) {
-    out << header(g, dataPath.filename().string());
-  });
+  writeFile(path, ".mhd",
+            [&](std::ofstream& out) { out << header(g, dataPath.filename().string()); });
 }
 
 }  // namespace visopt::io

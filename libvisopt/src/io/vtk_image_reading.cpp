@@ -22,20 +22,33 @@ namespace {
 std::optional<ScalarType> fromVtkType(int vtkType) {
   switch (vtkType) {
     case VTK_CHAR:
-    case VTK_SIGNED_CHAR: return ScalarType::Int8;
-    case VTK_UNSIGNED_CHAR: return ScalarType::UInt8;
-    case VTK_SHORT: return ScalarType::Int16;
-    case VTK_UNSIGNED_SHORT: return ScalarType::UInt16;
-    case VTK_INT: return ScalarType::Int32;
-    case VTK_UNSIGNED_INT: return ScalarType::UInt32;
-    case VTK_LONG: return sizeof(long) == 8 ? ScalarType::Int64 : ScalarType::Int32;
-    case VTK_UNSIGNED_LONG: return sizeof(long) == 8 ? ScalarType::UInt64 : ScalarType::UInt32;
+    case VTK_SIGNED_CHAR:
+      return ScalarType::Int8;
+    case VTK_UNSIGNED_CHAR:
+      return ScalarType::UInt8;
+    case VTK_SHORT:
+      return ScalarType::Int16;
+    case VTK_UNSIGNED_SHORT:
+      return ScalarType::UInt16;
+    case VTK_INT:
+      return ScalarType::Int32;
+    case VTK_UNSIGNED_INT:
+      return ScalarType::UInt32;
+    case VTK_LONG:
+      return sizeof(long) == 8 ? ScalarType::Int64 : ScalarType::Int32;
+    case VTK_UNSIGNED_LONG:
+      return sizeof(long) == 8 ? ScalarType::UInt64 : ScalarType::UInt32;
     case VTK_LONG_LONG:
-    case VTK_ID_TYPE: return ScalarType::Int64;
-    case VTK_UNSIGNED_LONG_LONG: return ScalarType::UInt64;
-    case VTK_FLOAT: return ScalarType::Float32;
-    case VTK_DOUBLE: return ScalarType::Float64;
-    default: return std::nullopt;
+    case VTK_ID_TYPE:
+      return ScalarType::Int64;
+    case VTK_UNSIGNED_LONG_LONG:
+      return ScalarType::UInt64;
+    case VTK_FLOAT:
+      return ScalarType::Float32;
+    case VTK_DOUBLE:
+      return ScalarType::Float64;
+    default:
+      return std::nullopt;
   }
 }
 
@@ -50,10 +63,11 @@ VolumeHeader dimsOnly(const int extent[6], int components) {
 }  // namespace
 
 VtkImageRead runVtkImageReader(const std::string& path, vtkAlgorithm* reader,
-                               const ProgressCallback& progress) {
+                               const ProgressCallback& progress, bool warningsAreErrors) {
   VtkErrorCapture capture(reader);
-  auto fail = [&](const std::string& fallback) {
-    throwBadInput(path, capture.error().value_or(fallback));
+  auto fail = [&](const std::string& what) {
+    auto detail = capture.error() ? capture.error() : capture.warning();
+    throwBadInput(path, detail ? what + ": " + *detail : what);
   };
 
   reader->UpdateInformation();
@@ -74,6 +88,8 @@ VtkImageRead runVtkImageReader(const std::string& path, vtkAlgorithm* reader,
 
   reader->Update();
   if (capture.error() || reader->GetErrorCode() != 0) fail("cannot read the data");
+  if (warningsAreErrors && capture.warning())
+    throwBadInput(path, "truncated or corrupt data: " + *capture.warning());
   VtkImageRead out;
   out.image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));
   if (!out.image) fail("reader produced no image");
@@ -114,7 +130,8 @@ VolumeHeader headerFromVtkImage(const VtkImageRead& read) {
   read.image->GetOrigin(origin);
   vtkMatrix3x3* m = read.image->GetDirectionMatrix();
   for (int c = 0; c < 3; ++c)
-    for (int r = 0; r < 3; ++r) h.direction[size_t(c)][size_t(r)] = m ? m->GetElement(r, c) : (r == c);
+    for (int r = 0; r < 3; ++r)
+      h.direction[size_t(c)][size_t(r)] = m ? m->GetElement(r, c) : (r == c);
   for (int a = 0; a < 3; ++a) h.spacing[size_t(a)] = spacing[a];
   // World position of the first voxel: origin + D * (extentMin * spacing).
   for (int r = 0; r < 3; ++r) {

@@ -18,11 +18,13 @@ namespace visopt::io {
 struct VtkImageRead {
   vtkSmartPointer<vtkImageData> image;
   ScalarData scalars;
-  std::array<int, 3> extentMin{0, 0, 0};  // index of the first voxel (VTK extents need not start at 0)
+  std::array<int, 3> extentMin{0, 0,
+                               0};  // index of the first voxel (VTK extents need not start at 0)
 };
 
+// warningsAreErrors: for readers that only warn when the data runs short (legacy VTK).
 VtkImageRead runVtkImageReader(const std::string& path, vtkAlgorithm* reader,
-                               const ProgressCallback& progress);
+                               const ProgressCallback& progress, bool warningsAreErrors = false);
 
 // Geometry of a vtkImageData (spacing, origin, direction matrix), with the origin moved to the
 // first voxel of the extent, as a header for checkHeader().

@@ -5,6 +5,7 @@
 
 #include <vtkCallbackCommand.h>
 #include <vtkCommand.h>
+#include <vtkLogger.h>
 #include <vtkObjectFactory.h>
 #include <vtkOutputWindow.h>
 #include <vtkSmartPointer.h>
@@ -13,16 +14,20 @@ namespace visopt::io {
 
 namespace {
 
-// Errors that reached the output window on this thread while a capture was active.
-thread_local std::vector<std::string>* activeLog = nullptr;
+// Errors and warnings that reached the output window on this thread while a capture was active
+// (messages from objects nobody observes, e.g. the executive or vtkGenericWarningMacro).
+thread_local std::vector<std::string>* activeErrors = nullptr;
+thread_local std::vector<std::string>* activeWarnings = nullptr;
 
 class CapturingOutputWindow : public vtkOutputWindow {
  public:
   static CapturingOutputWindow* New();
-  vtkTypeMacro(CapturingOutputWindow, vtkOutputWindow);
-  void DisplayText(const char* text) override {
-    if (activeLog && text && this->GetCurrentMessageType() == MESSAGE_TYPE_ERROR)
-      activeLog->push_back(text);
+  vtkTypeMacro(CapturingOutputWindow, vtkOutputWindow) void DisplayText(const char* text) override {
+    if (!text) return;
+    const MessageTypes type = this->GetCurrentMessageType();
+    if (activeErrors && type == MESSAGE_TYPE_ERROR) activeErrors->push_back(text);
+    if (activeWarnings && (type == MESSAGE_TYPE_WARNING || type == MESSAGE_TYPE_GENERIC_WARNING))
+      activeWarnings->push_back(text);
   }
 };
 vtkStandardNewMacro(CapturingOutputWindow);
@@ -32,6 +37,8 @@ void installQuietOutputWindow() {
   std::call_once(once, [] {
     vtkSmartPointer<CapturingOutputWindow> window = vtkSmartPointer<CapturingOutputWindow>::New();
     vtkOutputWindow::SetInstance(window);
+    // VTK 9 also sends every error and warning to its logger, which prints to stderr.
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
   });
 }
 
@@ -41,8 +48,9 @@ struct VtkErrorCapture::Impl {
   vtkObject* watched = nullptr;
   unsigned long errorTag = 0, warningTag = 0;
   vtkSmartPointer<vtkCallbackCommand> callback;
-  std::vector<std::string> errors;
-  std::vector<std::string>* previousLog = nullptr;
+  std::vector<std::string> errors, warnings;
+  std::vector<std::string>* previousErrors = nullptr;
+  std::vector<std::string>* previousWarnings = nullptr;
 };
 
 std::string cleanVtkMessage(const std::string& text) {
@@ -51,7 +59,8 @@ std::string cleanVtkMessage(const std::string& text) {
   size_t pos = 0;
   while (pos <= text.size()) {
     size_t eol = text.find('\n', pos);
-    std::string candidate = text.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
+    std::string candidate =
+        text.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
     if (candidate.find_first_not_of(" \t\r") != std::string::npos) line = candidate;
     if (eol == std::string::npos) break;
     pos = eol + 1;
@@ -69,15 +78,19 @@ VtkErrorCapture::VtkErrorCapture(vtkObject* watched) : impl_(new Impl) {
   impl_->callback->SetClientData(impl_);
   impl_->callback->SetCallback([](vtkObject*, unsigned long event, void* client, void* callData) {
     auto* self = static_cast<Impl*>(client);
-    if (event == vtkCommand::ErrorEvent && callData)
-      self->errors.push_back(static_cast<const char*>(callData));
+    if (!callData) return;
+    if (event == vtkCommand::ErrorEvent) self->errors.push_back(static_cast<const char*>(callData));
+    if (event == vtkCommand::WarningEvent)
+      self->warnings.push_back(static_cast<const char*>(callData));
   });
   if (watched) {
     impl_->errorTag = watched->AddObserver(vtkCommand::ErrorEvent, impl_->callback);
     impl_->warningTag = watched->AddObserver(vtkCommand::WarningEvent, impl_->callback);
   }
-  impl_->previousLog = activeLog;
-  activeLog = &impl_->errors;
+  impl_->previousErrors = activeErrors;
+  impl_->previousWarnings = activeWarnings;
+  activeErrors = &impl_->errors;
+  activeWarnings = &impl_->warnings;
 }
 
 VtkErrorCapture::~VtkErrorCapture() {
@@ -85,7 +98,8 @@ VtkErrorCapture::~VtkErrorCapture() {
     impl_->watched->RemoveObserver(impl_->errorTag);
     impl_->watched->RemoveObserver(impl_->warningTag);
   }
-  activeLog = impl_->previousLog;
+  activeErrors = impl_->previousErrors;
+  activeWarnings = impl_->previousWarnings;
   delete impl_;
 }
 
@@ -94,6 +108,14 @@ std::optional<std::string> VtkErrorCapture::error() const {
   return cleanVtkMessage(impl_->errors.front());
 }
 
-void VtkErrorCapture::clear() { impl_->errors.clear(); }
+std::optional<std::string> VtkErrorCapture::warning() const {
+  if (impl_->warnings.empty()) return std::nullopt;
+  return cleanVtkMessage(impl_->warnings.front());
+}
+
+void VtkErrorCapture::clear() {
+  impl_->errors.clear();
+  impl_->warnings.clear();
+}
 
 }  // namespace visopt::io

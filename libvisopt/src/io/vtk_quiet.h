@@ -21,6 +21,8 @@ class VtkErrorCapture {
 
   // The first error reported since construction (or the last clear()), reduced to one line.
   std::optional<std::string> error() const;
+  // The first warning, likewise (some readers only warn about short data).
+  std::optional<std::string> warning() const;
   void clear();
 
  private:

@@ -16,6 +16,7 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
+#include "kernels/ray_box.h"
 #include "kernels/transfer_lookup.h"
 
 namespace visopt {
@@ -75,9 +76,13 @@ struct RayMarchKernel {
     return p.extinction.valid() ? p.extinction.sample(idx) : tfExtinction;
   }
 
-  VISOPT_HD float lightTransmittanceAt(glm::vec3 x) const {
+  // At surface-like samples (bias = the Blinn-Phong weight) T_L is looked up up to one light-grid
+  // cell towards the light: like a shadow map's depth bias, this keeps an opaque surface from
+  // shadowing itself through the grid's discretisation (moiré rings where the light grid's cells
+  // cut the surface). Homogeneous media (bias 0) keep the exact lookup.
+  VISOPT_HD float lightTransmittanceAt(glm::vec3 x, glm::vec3 toLight, float bias) const {
     if (!p.lightTransmittance.valid()) return 1.f;
-    glm::vec3 y = p.light.toGrid(x);
+    glm::vec3 y = p.light.toGrid(x + (bias * p.light.ds) * toLight);
     if (!p.lightTransmittance.inside(y)) return 1.f;
     return p.lightTransmittance.sample(y);
   }
@@ -91,27 +96,17 @@ struct RayMarchKernel {
     const glm::vec3 o = p.volume.toIndex(p.camera.eye);
     const glm::vec3 d = p.volume.directionToIndex(dir);  // index units per world unit
 
-    // Ray / box intersection in index space: the box spans the voxel centres.
-    glm::vec3 hi = glm::vec3(p.volume.dims - 1);
-    float t0 = 0.f, t1 = 3.0e38f;
-    for (int a = 0; a < 3; ++a) {
-      if (fabsf(d[a]) < 1e-12f) {
-        if (o[a] < 0.f || o[a] > hi[a]) t1 = -1.f;
-        continue;
-      }
-      float ta = (0.f - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
-      t0 = fmaxf(t0, fminf(ta, tb));
-      t1 = fminf(t1, fmaxf(ta, tb));
-    }
+    const RayInterval box = intersectBox(o, d, glm::vec3(p.volume.dims - 1));
+    const float t0 = box.t0, t1 = box.t1;
     glm::vec3 radiance(0.f);
     float transmittance = 1.f;
     int64_t samples = 0;
     if (t1 > t0) {
-      const int n = int(ceilf((t1 - t0) / p.step));
-      const float seg = (t1 - t0) / float(n);
+      const int count = int(ceilf((t1 - t0) / p.step));
+      const float seg = (t1 - t0) / float(count);
       const float offset = p.jitter ? hashToUnit(uint32_t(pixel) * 9781u + p.seed * 6271u) : 0.5f;
       const glm::vec3 toEye = -dir;
-      for (int s = 0; s < n && transmittance > p.earlyStop; ++s) {
+      for (int s = 0; s < count && transmittance > p.earlyStop; ++s) {
         const float t = t0 + (float(s) + offset) * seg;
         const glm::vec3 idx = o + t * d;
         ++samples;
@@ -127,13 +122,17 @@ struct RayMarchKernel {
         // Phase function: HG blended with Blinn-Phong about the gradient.
         const glm::vec3 toLight = glm::normalize(p.lightPosition - x);
         float phase = henyeyGreenstein(glm::dot(toLight, dir), p.hg);
-        if (p.kd > 0.f || p.ks > 0.f) {
+        float surfaceWeight = 0.f;
+        // Gradient shading only where the sample can still be seen: below that its effect on
+        // the pixel is under 1e-4 of the light's radiance.
+        if ((p.kd > 0.f || p.ks > 0.f) && transmittance * alpha > 1e-4f) {
           glm::vec3 gi(p.scalars.sample(idx + glm::vec3(1, 0, 0)) - p.scalars.sample(idx - glm::vec3(1, 0, 0)),
                        p.scalars.sample(idx + glm::vec3(0, 1, 0)) - p.scalars.sample(idx - glm::vec3(0, 1, 0)),
                        p.scalars.sample(idx + glm::vec3(0, 0, 1)) - p.scalars.sample(idx - glm::vec3(0, 0, 1)));
           gi *= 0.5f;  // normalised value change per voxel along each index axis
           const float perVoxel = glm::length(gi);
           const float weight = fminf(perVoxel / p.surfaceGradient, 1.f);
+          surfaceWeight = weight;
           if (weight > 0.f) {
             const glm::vec3 gw = p.volume.direction * (gi / p.volume.spacing);
             const glm::vec3 n = glm::normalize(gw);
@@ -141,7 +140,7 @@ struct RayMarchKernel {
                     weight * blinnPhong(n, toLight, toEye, p.kd, p.ks, p.shininess);
           }
         }
-        const float lightT = lightTransmittanceAt(x);
+        const float lightT = lightTransmittanceAt(x, toLight, surfaceWeight);
         radiance += transmittance * alpha * albedo *
                     (phase * lightT * p.lightRadiance + glm::vec3(p.ambient));
         transmittance *= 1.f - alpha;

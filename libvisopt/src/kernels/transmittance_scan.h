@@ -1,10 +1,12 @@
 // Front-to-back transmittance along the rays of a frustum grid (paper 000 Eqs. 4-5):
 // T(s) = exp(-integral from the eye to s of mu). One ray per (i, j), cells k front to back.
+// Each cell [s_k - ds/2, s_k + ds/2] contributes mu times the length of its overlap with the
+// volume's box, sampled at the overlap's midpoint, so a sharp box boundary costs no error.
 //
 // Two discretisations are offered:
-//  - Exclusive: T_k = exp(-sum_{j<k} mu_j ds), the discrete energy's definition (METHODS.md §1),
-//  - Midpoint:  T_k = exp(-(sum_{j<k} mu_j ds + mu_k ds / 2)), the value at the cell centre,
-//    which is what the renderer interpolates (second-order accurate for lookups).
+//  - Exclusive: T_k = exp(-sum_{j<k} tau_j), the discrete energy's definition (METHODS.md §1),
+//  - Midpoint:  T_k = exp(-(sum_{j<k} tau_j + tau_k / 2)), the value at the cell centre, which
+//    is what the renderer interpolates (second-order accurate for lookups).
 #pragma once
 
 #include <cmath>
@@ -13,26 +15,35 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
+#include "kernels/ray_box.h"
 
 namespace visopt {
 
-// Samples the extinction at a world position: mu from an explicit extinction field when given,
-// otherwise from the transfer function applied to the scalar field; 0 outside the volume.
+// ExtinctionAt: mu at a continuous index position inside the volume.
 template <class ExtinctionAt>
 struct TransmittanceScan {
   FrustumMap frustum;
+  GridMap volume;
   FieldView out;  // dims == frustum.dims
   ExtinctionAt extinction;
   bool midpoint = true;
 
   VISOPT_HD void operator()(int64_t ray) const {
     const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
+    const glm::vec3 dir = frustum.rayDirection(float(i), float(j));
+    const glm::vec3 o = volume.toIndex(frustum.eye);
+    const glm::vec3 d = volume.directionToIndex(dir);
+    const RayInterval box = intersectBox(o, d, glm::vec3(volume.dims - 1));
     float opticalDepth = 0.f;
     for (int k = 0; k < frustum.dims.z; ++k) {
-      glm::vec3 x = frustum.toWorld(glm::vec3(float(i), float(j), float(k)));
-      float mu = extinction(x) * frustum.ds;
-      out.store(out.index(i, j, k), expf(-(opticalDepth + (midpoint ? 0.5f * mu : 0.f))));
-      opticalDepth += mu;
+      float tau = 0.f;
+      if (!box.empty()) {
+        const float a = fmaxf(frustum.depthOf(float(k)) - 0.5f * frustum.ds, box.t0);
+        const float b = fminf(frustum.depthOf(float(k)) + 0.5f * frustum.ds, box.t1);
+        if (b > a) tau = extinction(o + (0.5f * (a + b)) * d) * (b - a);
+      }
+      out.store(out.index(i, j, k), expf(-(opticalDepth + (midpoint ? 0.5f * tau : 0.f))));
+      opticalDepth += tau;
     }
   }
 };

@@ -21,7 +21,6 @@ TransferLookup lookupOf(const RenderScene& scene) {
 
 VolumeExtinction extinctionOf(const RenderScene& scene) {
   VolumeExtinction e;
-  e.volume = GridMap(scene.volume->grid());
   e.scalars = FieldView(scene.volume->normalized);
   if (scene.extinction) e.extinction = FieldView(*scene.extinction);
   e.transfer = lookupOf(scene);
@@ -53,8 +52,8 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
                                Field3D& out) {
   if (out.grid().dims != lightFrustum.dims)
     throw Error(ErrorKind::Failure, "light transmittance field does not match its frustum");
-  TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum), FieldView(out),
-                                           extinctionOf(scene), true};
+  TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum), GridMap(scene.volume->grid()),
+                                           FieldView(out), extinctionOf(scene), true};
   exec::parallelFor("light transmittance", int64_t(lightFrustum.dims.x) * lightFrustum.dims.y,
                     scan);
 }

@@ -39,9 +39,11 @@ struct Slab {
     const float depth = glm::clamp((kCrustInner + 0.01f - r) / (kCrustInner - bottom), 0.f, 1.f);
     const float along = std::atan2(glm::dot(dir, b), glm::dot(dir, n0));
     const float strike = std::asin(glm::clamp(glm::dot(dir, t), -1.f, 1.f));
+    // Thinner and narrower with depth (a tongue), and buckled along the strike.
     const float thickness = halfThickness * (1.f - 0.35f * depth);
-    const float dThick = std::abs(along - dipAngle * depth * depth) * r - thickness;
-    const float dStrike = std::abs(strike) * r - halfAngle * r;
+    const float buckle = 0.06f * depth * std::sin(3.f * strike / halfAngle);
+    const float dThick = std::abs(along - dipAngle * depth * depth - buckle) * r - thickness;
+    const float dStrike = std::abs(strike) * r - halfAngle * (1.f - 0.4f * depth * depth) * r;
     const float dBottom = bottom - r;
     return softInside(dThick, w) * softInside(dStrike, 2.f * w) * softInside(dBottom, 2.f * w);
   }
@@ -75,8 +77,8 @@ BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* 
   };
 
   BuiltinScene scene;
-  scene.volume = generateVolume(
-      "earth-mantle", grid, precision, ledger, -1.0, 1.0, [=](glm::vec3 p) {
+  scene.volume =
+      generateVolume("earth-mantle", grid, precision, ledger, -1.0, 1.0, [=](glm::vec3 p) {
         const float r = glm::length(p);
         if (r > kCrustOuter + 2.f * w) return 0.f;
         float v = mantleNoise(p);
@@ -85,8 +87,7 @@ BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* 
         for (const SoftEllipsoid& e : blobs) v += (kBlobValue - v) * softInside(e.distance(p), ws);
         v += (kCoreValue - v) * softInside(r - kCoreRadius, w);
         const float crustHalf = 0.5f * (kCrustOuter - kCrustInner);
-        v += (kCrustValue - v) *
-             softInside(std::abs(r - (kCrustOuter - crustHalf)) - crustHalf, w);
+        v += (kCrustValue - v) * softInside(std::abs(r - (kCrustOuter - crustHalf)) - crustHalf, w);
         // Empty space outside the crust is neutral.
         return v * softInside(r - kCrustOuter, w);
       });
@@ -94,8 +95,8 @@ BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* 
   TransferFunction& tf = scene.transferFunction;
   tf.name = "earth-mantle";
   tf.unitDistance = 2.f;  // mm
-  tf.opacity = {{-1.0, 0.6f}, {-0.5, 0.45f}, {-0.3, 0.f},  {0.3, 0.f},   {0.55, 0.5f},
-                {0.8, 0.7f},  {0.9, 0.95f},  {1.0, 0.97f}};
+  tf.opacity = {{-1.0, 0.6f}, {-0.5, 0.45f}, {-0.3, 0.f},  {0.3, 0.f},
+                {0.55, 0.5f}, {0.8, 0.7f},   {0.9, 0.95f}, {1.0, 0.97f}};
   tf.color = {{-1.0, {0.15f, 0.35f, 0.95f}}, {-0.45, {0.40f, 0.65f, 1.00f}},
               {0.0, {0.90f, 0.90f, 0.90f}},  {0.55, {1.00f, 0.55f, 0.15f}},
               {0.8, {0.95f, 0.30f, 0.10f}},  {0.9, {0.45f, 0.55f, 0.30f}},

@@ -29,7 +29,7 @@ BuiltinScene makeHydrogen(int resolution, Precision precision, MemoryLedger* led
   TransferFunction& tf = scene.transferFunction;
   tf.name = "hydrogen";
   tf.unitDistance = 2.f;
-  tf.opacity = {{0.0, 0.f},  {0.03, 0.f}, {0.12, 0.25f}, {0.25, 0.5f},
+  tf.opacity = {{0.0, 0.f},   {0.03, 0.f}, {0.12, 0.25f}, {0.25, 0.5f},
                 {0.35, 0.1f}, {0.6, 0.4f}, {1.0, 0.7f}};
   tf.color = {{0.0, {0.20f, 0.40f, 0.90f}},
               {0.25, {0.30f, 0.55f, 0.95f}},

@@ -20,15 +20,14 @@ double marschnerLobb(glm::dvec3 p) {
 BuiltinScene makeMarschnerLobb(int resolution, Precision precision, MemoryLedger* ledger) {
   checkResolution("marschner-lobb", resolution);
   BuiltinScene scene;
-  scene.volume = generateVolume("marschner-lobb", sceneGrid(resolution), precision, ledger, 0.0,
-                                1.0, [](glm::vec3 p) {
-                                  return static_cast<float>(marschnerLobb(glm::dvec3(p)));
-                                });
+  scene.volume =
+      generateVolume("marschner-lobb", sceneGrid(resolution), precision, ledger, 0.0, 1.0,
+                     [](glm::vec3 p) { return static_cast<float>(marschnerLobb(glm::dvec3(p))); });
   TransferFunction& tf = scene.transferFunction;
   tf.name = "marschner-lobb";
   tf.unitDistance = 2.f;
-  tf.opacity = {{0.0, 0.f},  {0.42, 0.f}, {0.5, 0.5f}, {0.58, 0.f},
-                {0.7, 0.f},  {0.8, 0.2f}, {1.0, 0.4f}};
+  tf.opacity = {{0.0, 0.f}, {0.42, 0.f}, {0.5, 0.5f}, {0.58, 0.f},
+                {0.7, 0.f}, {0.8, 0.2f}, {1.0, 0.4f}};
   tf.color = {{0.0, {0.20f, 0.35f, 0.80f}},
               {0.5, {0.85f, 0.85f, 0.85f}},
               {0.75, {0.95f, 0.60f, 0.20f}},

@@ -19,16 +19,20 @@ constexpr float kFluidTop = 0.75f;
 constexpr float kRodRadius = 0.05f, kRodBottom = -0.6f;
 constexpr float kSolidValue = -1.f;
 
-float maxOf(float a, float b) { return a > b ? a : b; }
-float minOf(float a, float b) { return a < b ? a : b; }
+float maxOf(float a, float b) {
+  return a > b ? a : b;
+}
+float minOf(float a, float b) {
+  return a < b ? a : b;
+}
 
 // Signed distance to the tank (side wall open at the top, closed bottom), rod and paddle.
 float solidDistance(glm::vec3 p, float rho) {
   const float wallMid = kTankInner + 0.5f * kWall;
-  const float side = maxOf(std::abs(rho - wallMid) - 0.5f * kWall,
-                           maxOf(p.z - kTankTop, kTankBottom - p.z));
-  const float bottom =
-      maxOf(rho - (kTankInner + kWall), std::abs(p.z - (kTankBottom + 0.5f * kWall)) - 0.5f * kWall);
+  const float side =
+      maxOf(std::abs(rho - wallMid) - 0.5f * kWall, maxOf(p.z - kTankTop, kTankBottom - p.z));
+  const float bottom = maxOf(rho - (kTankInner + kWall),
+                             std::abs(p.z - (kTankBottom + 0.5f * kWall)) - 0.5f * kWall);
   const float rod = maxOf(rho - kRodRadius, kRodBottom - p.z);
   // Paddle: a flat blade across the rod's foot, turned 30 degrees about z.
   const float c = std::cos(kPi / 6.f), s = std::sin(kPi / 6.f);
@@ -56,36 +60,37 @@ BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger
   const float cosLead = std::cos(std::atan(pitch / (2.f * kPi * helixR)));
 
   BuiltinScene scene;
-  scene.volume = generateVolume(
-      "mixer", grid, precision, ledger, -1.0, 1.0, [=](glm::vec3 p) {
-        const float rho = std::sqrt(p.x * p.x + p.y * p.y);
-        // Quiet fluid with a little swirl, inside the tank up to the free surface.
-        float vort = 0.05f + 0.03f * std::sin(6.f * p.z + 3.f * rho);
-        const float theta = std::atan2(p.y, p.x);
-        for (int arm = 0; arm < 2; ++arm) {
-          float dz = p.z - helixLo - pitch * (theta / (2.f * kPi) + 0.5f * float(arm));
-          dz -= pitch * std::round(dz / pitch);
-          const float d2 = (rho - helixR) * (rho - helixR) + dz * cosLead * dz * cosLead;
-          const float fade = softInside(maxOf(helixLo - p.z, p.z - helixHi), 0.08f);
-          vort = maxOf(vort, helixStrength * fade * std::exp(-d2 / (helixCore * helixCore)));
-        }
-        for (const Ring& ring : rings) {
-          const float d2 = (rho - ring.radius) * (rho - ring.radius) + (p.z - ring.z) * (p.z - ring.z);
-          vort = maxOf(vort, ring.strength * std::exp(-d2 / (ring.core * ring.core)));
-        }
-        const float fluid = softInside(
-            maxOf(rho - kTankInner, maxOf(p.z - kFluidTop, kTankBottom + kWall - p.z)), w);
-        const float v = fluid * vort;
-        return v + (kSolidValue - v) * softInside(solidDistance(p, rho), w);
-      });
+  scene.volume = generateVolume("mixer", grid, precision, ledger, -1.0, 1.0, [=](glm::vec3 p) {
+    const float rho = std::sqrt(p.x * p.x + p.y * p.y);
+    // Quiet fluid with a little swirl, inside the tank up to the free surface.
+    float vort = 0.05f + 0.03f * std::sin(6.f * p.z + 3.f * rho);
+    const float theta = std::atan2(p.y, p.x);
+    for (int arm = 0; arm < 2; ++arm) {
+      float dz = p.z - helixLo - pitch * (theta / (2.f * kPi) + 0.5f * float(arm));
+      dz -= pitch * std::round(dz / pitch);
+      const float d2 = (rho - helixR) * (rho - helixR) + dz * cosLead * dz * cosLead;
+      const float fade = softInside(maxOf(helixLo - p.z, p.z - helixHi), 0.08f);
+      vort = maxOf(vort, helixStrength * fade * std::exp(-d2 / (helixCore * helixCore)));
+    }
+    for (const Ring& ring : rings) {
+      const float d2 = (rho - ring.radius) * (rho - ring.radius) + (p.z - ring.z) * (p.z - ring.z);
+      vort = maxOf(vort, ring.strength * std::exp(-d2 / (ring.core * ring.core)));
+    }
+    const float fluid =
+        softInside(maxOf(rho - kTankInner, maxOf(p.z - kFluidTop, kTankBottom + kWall - p.z)), w);
+    const float v = fluid * vort;
+    return v + (kSolidValue - v) * softInside(solidDistance(p, rho), w);
+  });
 
   TransferFunction& tf = scene.transferFunction;
   tf.name = "mixer";
   tf.unitDistance = 2.f;  // mm
   tf.opacity = {{-1.0, 0.97f}, {-0.75, 0.9f}, {-0.5, 0.f}, {0.15, 0.f},
                 {0.3, 0.08f},  {0.6, 0.4f},   {1.0, 0.6f}};
-  tf.color = {{-1.0, {0.62f, 0.66f, 0.72f}}, {-0.5, {0.62f, 0.66f, 0.72f}},
-              {0.2, {0.95f, 0.85f, 0.30f}},  {0.6, {0.95f, 0.45f, 0.15f}},
+  tf.color = {{-1.0, {0.62f, 0.66f, 0.72f}},
+              {-0.5, {0.62f, 0.66f, 0.72f}},
+              {0.2, {0.95f, 0.85f, 0.30f}},
+              {0.6, {0.95f, 0.45f, 0.15f}},
               {1.0, {0.80f, 0.10f, 0.10f}}};
   tf.validate("scene mixer");
   scene.azimuthDeg = 30.f;

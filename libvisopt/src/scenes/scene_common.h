@@ -32,8 +32,11 @@ void checkResolution(const std::string& scene, int resolution);
 // A resolution^3 grid whose voxel centres span [-kSceneHalf, kSceneHalf]^3, direction identity.
 GridSpec sceneGrid(int resolution);
 
-// Half-width (normalised units) of the smooth edge of shapes: half a voxel.
-inline float edgeHalfWidth(const GridSpec& grid) { return 0.5f * grid.minSpacing() / kSceneHalf; }
+// Half-width (normalised units) of the smooth edge of shapes: one voxel. A narrower edge shows
+// the voxel terraces in gradient-based shading as moiré rings on smooth surfaces.
+inline float edgeHalfWidth(const GridSpec& grid) {
+  return 1.0f * grid.minSpacing() / kSceneHalf;
+}
 
 // Hermite smoothstep, 0 below e0 and 1 above e1.
 inline float smoothStep(float e0, float e1, float x) {
@@ -42,7 +45,9 @@ inline float smoothStep(float e0, float e1, float x) {
 }
 
 // Soft inside-indicator from an (approximate) signed distance d (< 0 inside), edge half-width w.
-inline float softInside(float d, float w) { return 1.f - smoothStep(-w, w, d); }
+inline float softInside(float d, float w) {
+  return 1.f - smoothStep(-w, w, d);
+}
 
 // Samples value(p) (p in normalised coordinates, value in data units) at every voxel centre and
 // stores (value - valueMin) / (valueMax - valueMin), clamped to [0, 1], in Field3D "volume".
@@ -61,15 +66,13 @@ Volume generateVolume(const std::string& name, const GridSpec& grid, Precision p
   const float lo = static_cast<float>(valueMin);
   const float invSpan = static_cast<float>(1.0 / (valueMax - valueMin));
   const int64_t nx = grid.dims.x, ny = grid.dims.y;
-  exec::parallelFor("scene-generate", static_cast<int64_t>(grid.voxelCount()),
-                    [=](int64_t idx) {
-                      const int64_t i = idx % nx, j = (idx / nx) % ny, k = idx / (nx * ny);
-                      const glm::vec3 world = g.indexToWorld(glm::vec3(
-                          static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)));
-                      const float v = value(world / kSceneHalf);
-                      view.store(static_cast<size_t>(idx),
-                                 glm::clamp((v - lo) * invSpan, 0.f, 1.f));
-                    });
+  exec::parallelFor("scene-generate", static_cast<int64_t>(grid.voxelCount()), [=](int64_t idx) {
+    const int64_t i = idx % nx, j = (idx / nx) % ny, k = idx / (nx * ny);
+    const glm::vec3 world = g.indexToWorld(
+        glm::vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)));
+    const float v = value(world / kSceneHalf);
+    view.store(static_cast<size_t>(idx), glm::clamp((v - lo) * invSpan, 0.f, 1.f));
+  });
   return vol;
 }
 
@@ -87,7 +90,9 @@ struct SoftEllipsoid {
 
   SoftEllipsoid() = default;
   SoftEllipsoid(glm::vec3 c, glm::vec3 semiAxes, float angleDeg)
-      : center(c), invAxes(1.f / semiAxes), cosA(std::cos(glm::radians(angleDeg))),
+      : center(c),
+        invAxes(1.f / semiAxes),
+        cosA(std::cos(glm::radians(angleDeg))),
         sinA(std::sin(glm::radians(angleDeg))) {}
 
   glm::vec3 local(glm::vec3 p) const {

@@ -38,7 +38,9 @@ std::vector<SceneDescription> builtinScenes() {
   return out;
 }
 
-std::string defaultSceneName() { return "shepp-logan"; }
+std::string defaultSceneName() {
+  return "shepp-logan";
+}
 
 BuiltinScene makeBuiltinScene(const std::string& name, int resolution, Precision precision,
                               MemoryLedger* ledger) {

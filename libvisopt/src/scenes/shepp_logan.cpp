@@ -16,12 +16,12 @@ constexpr size_t kEllipsoids = 10;
 const std::vector<PhantomEllipsoid>& sheppLoganEllipsoids() {
   // centre, semi-axes, rotation about z (degrees), density
   static const std::vector<PhantomEllipsoid> table = {
-      {{0.f, 0.f, 0.f}, {0.69f, 0.92f, 0.81f}, 0.f, 1.0f},            // outer shell
-      {{0.f, -0.0184f, 0.f}, {0.6624f, 0.874f, 0.78f}, 0.f, -0.8f},   // brain
-      {{0.22f, 0.f, 0.f}, {0.11f, 0.31f, 0.22f}, -18.f, -0.2f},       // right ventricle
-      {{-0.22f, 0.f, 0.f}, {0.16f, 0.41f, 0.28f}, 18.f, -0.2f},       // left ventricle
-      {{0.f, 0.35f, -0.15f}, {0.21f, 0.25f, 0.41f}, 0.f, 0.1f},       // large tumour
-      {{0.f, 0.1f, 0.25f}, {0.046f, 0.046f, 0.05f}, 0.f, 0.1f},       // small tumours
+      {{0.f, 0.f, 0.f}, {0.69f, 0.92f, 0.81f}, 0.f, 1.0f},           // outer shell
+      {{0.f, -0.0184f, 0.f}, {0.6624f, 0.874f, 0.78f}, 0.f, -0.8f},  // brain
+      {{0.22f, 0.f, 0.f}, {0.11f, 0.31f, 0.22f}, -18.f, -0.2f},      // right ventricle
+      {{-0.22f, 0.f, 0.f}, {0.16f, 0.41f, 0.28f}, 18.f, -0.2f},      // left ventricle
+      {{0.f, 0.35f, -0.15f}, {0.21f, 0.25f, 0.41f}, 0.f, 0.1f},      // large tumour
+      {{0.f, 0.1f, 0.25f}, {0.046f, 0.046f, 0.05f}, 0.f, 0.1f},      // small tumours
       {{0.f, -0.1f, 0.25f}, {0.046f, 0.046f, 0.05f}, 0.f, 0.1f},
       {{-0.08f, -0.605f, 0.f}, {0.046f, 0.023f, 0.05f}, 0.f, 0.1f},
       {{0.f, -0.606f, 0.f}, {0.023f, 0.023f, 0.02f}, 0.f, 0.1f},
@@ -49,34 +49,35 @@ BuiltinScene makeSheppLogan(int resolution, Precision precision, MemoryLedger* l
     density[n] = table[n].density;
   }
   BuiltinScene scene;
-  scene.volume = generateVolume("shepp-logan", grid, precision, ledger, 0.0, 1.0,
-                                [=](glm::vec3 p) {
-                                  // Outside the head nothing contributes.
-                                  if (shapes[0].distance(p) > w) return 0.f;
-                                  float sum = 0.f;
-                                  for (size_t n = 0; n < kEllipsoids; ++n)
-                                    sum += density[n] * softInside(shapes[n].distance(p), w);
-                                  return sum;
-                                });
+  scene.volume = generateVolume("shepp-logan", grid, precision, ledger, 0.0, 1.0, [=](glm::vec3 p) {
+    // Outside the head nothing contributes.
+    if (shapes[0].distance(p) > w) return 0.f;
+    float sum = 0.f;
+    for (size_t n = 0; n < kEllipsoids; ++n)
+      sum += density[n] * softInside(shapes[n].distance(p), w);
+    return sum;
+  });
 
   TransferFunction& tf = scene.transferFunction;
   tf.name = "shepp-logan";
   tf.unitDistance = 2.f;  // mm
   // Ventricles and air clear, brain a faint haze, tumours (0.3) red, the shell nearly opaque.
-  tf.opacity = {{0.0, 0.f},   {0.1, 0.f},   {0.2, 0.01f}, {0.24, 0.01f}, {0.27, 0.35f},
-                {0.33, 0.35f}, {0.37, 0.f}, {0.45, 0.f},  {0.6, 0.85f},  {0.8, 0.95f},
-                {1.0, 0.97f}};
+  tf.opacity = {{0.0, 0.f},    {0.1, 0.f},    {0.2, 0.005f}, {0.25, 0.005f},
+                {0.28, 0.35f}, {0.32, 0.35f}, {0.36, 0.f},   {0.45, 0.f},
+                {0.6, 0.85f},  {0.8, 0.95f},  {1.0, 0.97f}};
   tf.color = {{0.0, {0.50f, 0.50f, 0.55f}},  {0.2, {0.75f, 0.70f, 0.70f}},
-              {0.24, {0.75f, 0.70f, 0.70f}}, {0.27, {0.95f, 0.30f, 0.20f}},
-              {0.33, {0.95f, 0.30f, 0.20f}}, {0.45, {0.93f, 0.70f, 0.58f}},
+              {0.25, {0.75f, 0.70f, 0.70f}}, {0.28, {0.95f, 0.30f, 0.20f}},
+              {0.32, {0.95f, 0.30f, 0.20f}}, {0.45, {0.93f, 0.70f, 0.58f}},
               {1.0, {0.98f, 0.85f, 0.75f}}};
   tf.validate("scene shepp-logan");
   scene.azimuthDeg = 25.f;
   scene.elevationDeg = 20.f;
   scene.distanceInRadii = 2.8f;
-  // The tumours (density 0.3 on the normalised axis [0, 1]).
-  scene.importanceCurve = {{0.f, 0.f}, {0.25f, 0.f}, {0.28f, 1.f}, {0.32f, 1.f}, {0.35f, 0.f},
-                           {1.f, 0.f}};
+  // The tumours (density 0.3 on the normalised axis [0, 1]). The band is narrow because every
+  // shell voxel's smooth edge also passes through 0.3 (air 0 -> shell 1 -> brain 0.2); the
+  // narrower the band, the thinner that unwanted layer.
+  scene.importanceCurve = {{0.f, 0.f},   {0.27f, 0.f}, {0.29f, 1.f},
+                           {0.31f, 1.f}, {0.33f, 0.f}, {1.f, 0.f}};
   return scene;
 }
 

@@ -56,9 +56,9 @@ TransferFunction fromParaView(const nlohmann::json& doc, const std::string& orig
   }
   const std::vector<double> rgb = readFlatList(preset, "RGBPoints", 4, origin);
   for (size_t i = 0; i < rgb.size(); i += 4)
-    tf.color.push_back(ColorPoint{rgb[i], glm::vec3(static_cast<float>(rgb[i + 1]),
-                                                    static_cast<float>(rgb[i + 2]),
-                                                    static_cast<float>(rgb[i + 3]))});
+    tf.color.push_back(
+        ColorPoint{rgb[i], glm::vec3(static_cast<float>(rgb[i + 1]), static_cast<float>(rgb[i + 2]),
+                                     static_cast<float>(rgb[i + 3]))});
   if (preset.contains("Points")) {
     const std::vector<double> pts = readFlatList(preset, "Points", 4, origin);
     for (size_t i = 0; i < pts.size(); i += 4)

@@ -49,8 +49,8 @@ void TransferFunction::validate(const std::string& origin) {
   if (opacity.empty()) throwBadInput(where, "no opacity points");
   if (color.empty()) throwBadInput(where, "no colour points");
   if (!std::isfinite(unitDistance) || unitDistance < 0.f)
-    throwBadInput(where, "unitDistance must be finite and >= 0 (got " +
-                             formatNumber(unitDistance) + ")");
+    throwBadInput(where,
+                  "unitDistance must be finite and >= 0 (got " + formatNumber(unitDistance) + ")");
   for (size_t i = 0; i < opacity.size(); ++i) {
     const auto& p = opacity[i];
     const std::string at = "opacity point " + std::to_string(i);
@@ -64,8 +64,8 @@ void TransferFunction::validate(const std::string& origin) {
     if (!std::isfinite(p.value)) throwBadInput(where, at + ": value is not finite");
     for (int c = 0; c < 3; ++c)
       if (!std::isfinite(p.rgb[c]) || p.rgb[c] < 0.f || p.rgb[c] > 1.f)
-        throwBadInput(where, at + ": colour component " + formatNumber(p.rgb[c]) +
-                                 " is outside [0, 1]");
+        throwBadInput(where,
+                      at + ": colour component " + formatNumber(p.rgb[c]) + " is outside [0, 1]");
   }
   std::stable_sort(opacity.begin(), opacity.end(),
                    [](const OpacityPoint& a, const OpacityPoint& b) { return a.value < b.value; });

@@ -2,8 +2,8 @@
 // ParaView importer, and atomic file load/save.
 #include <charconv>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -54,8 +54,8 @@ TransferFunction fromVisopt(const nlohmann::json& doc, const std::string& origin
     const double version = readNumber(doc["version"], origin, "\"version\"");
     if (version > kVersion)
       throwBadInput(origin, "format version " + shortest(version, "") +
-                                " is newer than this visopt reads (" +
-                                std::to_string(kVersion) + ")");
+                                " is newer than this visopt reads (" + std::to_string(kVersion) +
+                                ")");
   }
   TransferFunction tf;
   if (doc.contains("name")) {
@@ -63,7 +63,8 @@ TransferFunction fromVisopt(const nlohmann::json& doc, const std::string& origin
     tf.name = doc["name"].get<std::string>();
   }
   if (doc.contains("unitDistance"))
-    tf.unitDistance = static_cast<float>(readNumber(doc["unitDistance"], origin, "\"unitDistance\""));
+    tf.unitDistance =
+        static_cast<float>(readNumber(doc["unitDistance"], origin, "\"unitDistance\""));
   for (const char* key : {"opacity", "color"}) {
     if (!doc.contains(key)) throwBadInput(origin, std::string("missing \"") + key + "\"");
     if (!doc[key].is_array()) throwBadInput(origin, std::string("\"") + key + "\" is not a list");
@@ -167,7 +168,11 @@ void TransferFunction::save(const std::string& path) const {
   if (!fs::is_directory(dir, ec)) throwBadInput(path, "directory does not exist");
   // A temporary next to the target, so the final rename stays on one file system (atomic).
   const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-  const fs::path tmp = dir / ("." + target.filename().string() + ".tmp" + std::to_string(stamp));
+  std::string tmpName = target.filename().string();
+  tmpName.insert(0, 1, '.');
+  tmpName.append(".tmp");
+  tmpName.append(std::to_string(stamp));
+  const fs::path tmp = dir / tmpName;
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throwBadInput(path, "cannot create a temporary file in " + dir.string());

@@ -1,0 +1,52 @@
+// Settings and statistics of the visibility optimisation (paper 000 §II-C, Eqs. 10-14).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace visopt {
+
+enum class OptimizerKind { AdEMAMix, Adam };
+OptimizerKind parseOptimizerKind(const std::string& text);  // "ademamix" | "adam"
+const char* toString(OptimizerKind kind);
+
+struct ExtinctionSettings {
+  // Energy weights: F = rho/2 ∫(mu - mu_bar)^2 - q ∫ g mu T_V - r ∫ g mu T_L (Eqs. 11-13).
+  // rho < 0 means "1 / mu_max", which makes rho (mu - mu_bar) a number in [-1, 1].
+  float rho = -1.f;
+  float q = 1.f;
+  float r = 0.f;   // 0: no light term, and no light-space grids are allocated
+  float muMax = 0.f;  // upper bound of Eq. 14 (1 / world unit); 0: the transfer function's maximum
+
+  OptimizerKind optimizer = OptimizerKind::AdEMAMix;
+  float learningRate = 0.05f;  // in units of mu_max per step
+  float beta1 = 0.9f, beta2 = 0.999f, beta3 = 0.9999f;  // AdEMAMix; Adam uses beta1, beta2
+  float alpha = 5.f;           // AdEMAMix slow-EMA weight
+  float epsilon = 1e-8f;
+  // Warm-up lengths of AdEMAMix's alpha and beta3 schedulers; 0 = the level's iteration cap.
+  int alphaWarmup = 0, beta3Warmup = 0;
+
+  int levels = 3;                 // coarse-to-fine multigrid levels
+  int maxIterationsPerLevel = 60;
+  float tolerance = 1e-4f;        // relative energy change that ends a level
+  int minIterationsPerLevel = 5;
+
+  // View frustum grid: rays per side as a fraction of the image size at the finest level, and
+  // depth cells (0: one per half voxel along the volume's bounding sphere, at most 1024).
+  float frustumScale = 0.5f;
+  int depthCells = 0;
+  int lightGridSize = 128;  // light frustum rays per side at the finest level
+};
+
+struct IterationStats {
+  int level = 0, iteration = 0;
+  double energyRho = 0.0, energyQ = 0.0, energyR = 0.0;
+  double energy() const { return energyRho + energyQ + energyR; }
+  double visibilityView = 0.0;   // V = ∫ g mu T_V / ∫ g mu over the view frustum
+  double visibilityLight = 0.0;  // the same from the light (0 when r = 0)
+  double stepNorm = 0.0;         // RMS of the change of mu over the voxels
+  double gridUpdatesMs = 0.0;    // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
+  double extinctionStepMs = 0.0; // gather, optimiser step, projection ("Ext. Opt.")
+};
+
+}  // namespace visopt

@@ -1,0 +1,98 @@
+// Grid updates of the extinction optimisation (paper 000 Eqs. 10-13; METHODS.md §1) along the
+// rays of a view- or light-space frustum grid.
+//
+// The discrete energy (the ground truth the gradient is checked against) is
+//   E = rho/2 sum_v (mu_v - mubar_v)^2 dV  -  q sum_c g_c mu_c T_c dV_c  -  r (same on the light grid)
+// over object voxels v and frustum cells c, with mu_c, g_c trilinear samples at the cell centres
+// (zero outside the volume's box), exclusive transmittance T_c = exp(-sum_{j<k} mu_j ds) along the
+// cell's ray, and the cell volume dV_c = Omega_ij s_k^2 ds (Omega_ij: the pixel's solid angle).
+//
+// dE/dmu at a cell, per unit volume, is -q d_c with
+//   d_c = g_c T_c - G_c,   G_c = (1 / s_k^2) sum_{j>k} g_j mu_j T_j s_j^2 ds,
+// where the s_j^2 / s_k^2 factor is the ray bundle's spread (cells are equal-solid-angle, not
+// equal-volume). One front-to-back pass gives T; one back-to-front pass gives G and d. The pass
+// re-samples mu and g rather than buffering the ray, so it needs no per-ray scratch memory on
+// either backend. Each ray also returns its contributions to the energy and to the
+// importance-weighted visibility V = sum g mu T dV / sum g mu dV.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "core/hd.h"
+
+namespace visopt {
+
+struct ScanSums {
+  double gMuT = 0.0;  // sum g mu T dV  (the visibility integral; energy term = -weight * this)
+  double gMu = 0.0;   // sum g mu dV
+  VISOPT_HD ScanSums operator+(const ScanSums& o) const { return {gMuT + o.gMuT, gMu + o.gMu}; }
+};
+
+struct VisibilityScan {
+  FrustumMap frustum;
+  GridMap volume;
+  FieldView mu;          // extinction on the object grid
+  FieldView importance;  // g on the object grid
+  FieldView out;         // d on the frustum grid; T is kept there between the two passes
+
+  // Pixel solid angle (for cell volumes): the tan-plane area over (1 + u^2 + v^2)^(3/2).
+  VISOPT_HD float solidAngle(int i, int j) const {
+    const float du = 2.f * frustum.tanX / float(frustum.dims.x);
+    const float dv = 2.f * frustum.tanY / float(frustum.dims.y);
+    const float u = (float(i) + 0.5f) * du - frustum.tanX;
+    const float v = (float(j) + 0.5f) * dv - frustum.tanY;
+    const float r2 = 1.f + u * u + v * v;
+    return du * dv / (r2 * sqrtf(r2));
+  }
+
+  // mu and g at a cell centre; zero outside the volume's box.
+  VISOPT_HD VISOPT_INLINE bool sampleAt(int i, int j, int k, float& m, float& g) const {
+    const glm::vec3 idx = volume.toIndex(frustum.toWorld(glm::vec3(float(i), float(j), float(k))));
+    const glm::vec3 hi = glm::vec3(volume.dims - 1);
+    if (idx.x < 0.f || idx.y < 0.f || idx.z < 0.f || idx.x > hi.x || idx.y > hi.y || idx.z > hi.z) {
+      m = g = 0.f;
+      return false;
+    }
+    m = mu.sample(idx);
+    g = importance.sample(idx);
+    return true;
+  }
+
+  VISOPT_HD ScanSums operator()(int64_t ray) const {
+    const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
+    const int nz = frustum.dims.z;
+    const float ds = frustum.ds;
+    // Front to back: exclusive transmittance.
+    float opticalDepth = 0.f;
+    for (int k = 0; k < nz; ++k) {
+      float m, g;
+      sampleAt(i, j, k, m, g);
+      out.store(out.index(i, j, k), expf(-opticalDepth));
+      opticalDepth += m * ds;
+    }
+    // Back to front: G (behind, weighted by s^2) and d = g T - G.
+    const float omega = solidAngle(i, j);
+    ScanSums sums;
+    float behind = 0.f;  // sum_{j>k} g mu T s^2 ds
+    for (int k = nz - 1; k >= 0; --k) {
+      float m, g;
+      sampleAt(i, j, k, m, g);
+      const size_t c = out.index(i, j, k);
+      const float t = out.load(c);
+      const float s = frustum.depthOf(float(k));
+      const float s2 = s * s;
+      out.store(c, g * t - behind / s2);
+      const float gmt = g * m * t;
+      behind += gmt * s2 * ds;
+      const double dV = double(omega) * double(s2) * double(ds);
+      sums.gMuT += double(gmt) * dV;
+      sums.gMu += double(g * m) * dV;
+    }
+    return sums;
+  }
+};
+
+}  // namespace visopt

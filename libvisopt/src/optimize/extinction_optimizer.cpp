@@ -1,0 +1,385 @@
+#include "optimize/extinction_optimizer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "exec/parallel.h"
+#include "kernels/extinction_step.h"
+#include "kernels/visibility_scan.h"
+#include "visopt/error.h"
+
+namespace visopt {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+TransferLookup lookupOf(const DeviceBuffer<glm::vec4>* t) {
+  return TransferLookup{t->data(), int(t->size())};
+}
+
+float voxelVolume(const GridSpec& g) { return g.spacing.x * g.spacing.y * g.spacing.z; }
+
+// Runs the visibility scan of one frustum grid into `d` (allocated or resized as needed).
+ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& grid,
+                  const Field3D& mu, const Field3D& importance, std::optional<Field3D>& d,
+                  const char* fieldName, Precision precision, MemoryLedger* ledger) {
+  if (!d || d->grid().dims != frustum.dims) {
+    d.reset();
+    GridSpec fg;
+    fg.dims = frustum.dims;
+    d.emplace(fieldName, fg, precision, ledger);
+  }
+  VisibilityScan scan{FrustumMap(frustum), GridMap(grid), FieldView(mu), FieldView(importance),
+                      FieldView(*d)};
+  return exec::reduce(name, int64_t(frustum.dims.x) * frustum.dims.y, ScanSums{}, scan,
+                      [] VISOPT_HD(const ScanSums& a, const ScanSums& b) { return a + b; });
+}
+
+ExtinctionGradient gradientOf(const ExtinctionProblem& p, const Field3D* dView,
+                              const Field3D* dLight) {
+  ExtinctionGradient g;
+  g.volume = GridMap(p.grid);
+  g.mu = FieldView(*p.mu);
+  if (p.baseField) g.base.field = FieldView(*p.baseField);
+  if (p.scalars) g.base.scalars = FieldView(*p.scalars);
+  if (p.transfer) g.base.transfer = lookupOf(p.transfer);
+  g.rho = p.rho;
+  g.q = dView ? p.q : 0.f;
+  g.r = dLight ? p.r : 0.f;
+  g.view = FrustumMap(p.view);
+  g.light = FrustumMap(p.light);
+  if (dView) g.dView = FieldView(*dView);
+  if (dLight) g.dLight = FieldView(*dLight);
+  return g;
+}
+
+struct ScanResult {
+  ScanSums view, light;
+  std::optional<Field3D> dView, dLight;
+};
+
+ScanResult scanProblem(const ExtinctionProblem& p, Precision precision) {
+  ScanResult r;
+  if (p.q != 0.f)
+    r.view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, r.dView,
+                      "view-derivative", precision, nullptr);
+  if (p.r != 0.f)
+    r.light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, r.dLight,
+                       "light-derivative", precision, nullptr);
+  return r;
+}
+
+}  // namespace
+
+ProblemEvaluation evaluateProblem(const ExtinctionProblem& p, Precision precision) {
+  ScanResult scans = scanProblem(p, precision);
+  ExtinctionGradient g = gradientOf(p, nullptr, nullptr);
+  const float dV = voxelVolume(p.grid);
+  const float rho = p.rho;
+  double eRho = exec::reduce(
+      "energy", int64_t(p.grid.voxelCount()), 0.0,
+      [=] VISOPT_HD(int64_t v) {
+        const float diff = g.mu.load(size_t(v)) - g.base.at(size_t(v));
+        return 0.5 * double(rho) * double(diff) * double(diff) * double(dV);
+      },
+      [] VISOPT_HD(double a, double b) { return a + b; });
+  ProblemEvaluation e;
+  e.energyRho = eRho;
+  e.energyQ = -double(p.q) * scans.view.gMuT;
+  e.energyR = -double(p.r) * scans.light.gMuT;
+  e.visibilityView = scans.view.gMu > 0 ? scans.view.gMuT / scans.view.gMu : 0.0;
+  e.visibilityLight = scans.light.gMu > 0 ? scans.light.gMuT / scans.light.gMu : 0.0;
+  return e;
+}
+
+std::vector<float> analyticGradient(const ExtinctionProblem& p, Precision precision) {
+  ScanResult scans = scanProblem(p, precision);
+  ExtinctionGradient g = gradientOf(p, scans.dView ? &*scans.dView : nullptr,
+                                    scans.dLight ? &*scans.dLight : nullptr);
+  DeviceBuffer<float> out(p.grid.voxelCount());
+  float* o = out.data();
+  exec::parallelFor("gradient", int64_t(out.size()), [=] VISOPT_HD(int64_t v) {
+    float mbar;
+    o[v] = g.at(v, mbar);
+  });
+  return std::vector<float>(o, o + out.size());
+}
+
+// ---- the optimiser ---------------------------------------------------------------------------
+
+struct ExtinctionOptimizer::Level {
+  int index = 0;
+  bool finest = false;
+  GridSpec grid;
+  std::optional<Field3D> mu, base, importance;  // base/importance only on coarse levels
+  std::optional<Field3D> m1, m2, rms;
+  std::optional<Field3D> dView, dLight;
+  FrustumGrid view, light;
+  int t = 0;  // optimiser steps taken on this level
+  double lastEnergy = 0.0;
+};
+
+ExtinctionOptimizer::ExtinctionOptimizer(MemoryLedger* ledger, Precision precision)
+    : ledger_(ledger), precision_(precision) {}
+ExtinctionOptimizer::~ExtinctionOptimizer() = default;
+
+const Field3D* ExtinctionOptimizer::extinction() const {
+  return level_ && level_->finest && level_->mu ? &*level_->mu : nullptr;
+}
+
+void ExtinctionOptimizer::reset() { level_.reset(); }
+
+namespace {
+
+GridSpec levelGrid(const GridSpec& fine, int factor) {
+  if (factor <= 1) return fine;
+  GridSpec g = fine;
+  for (int a = 0; a < 3; ++a) {
+    if (fine.dims[a] <= 2) continue;
+    g.dims[a] = std::max(2, (fine.dims[a] - 1 + factor - 1) / factor + 1);
+    g.spacing[a] = fine.spacing[a] * float(fine.dims[a] - 1) / float(g.dims[a] - 1);
+  }
+  return g;
+}
+
+float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s) {
+  float m = s.muMax > 0.f ? s.muMax : in.transferMaxExtinction;
+  return m > 0.f ? m : 1.f;
+}
+
+}  // namespace
+
+void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const ExtinctionSettings& s,
+                                     int index, int levels) {
+  const GridSpec& fine = in.volume->grid();
+  const int factor = 1 << (levels - 1 - index);
+  auto next = std::make_unique<Level>();
+  next->index = index;
+  next->finest = index == levels - 1;
+  next->grid = levelGrid(fine, factor);
+  const GridSpec grid = next->grid;
+  next->mu.emplace("extinction", grid, precision_, ledger_);
+  FieldView mu(*next->mu);
+  const GridMap map(grid);
+
+  if (!next->finest) {
+    // Coarse mu_bar and g: averages of the fine fields over each coarse voxel (3^3 samples).
+    next->base.emplace("extinction-base (coarse)", grid, precision_, ledger_);
+    next->importance.emplace("importance (coarse)", grid, precision_, ledger_);
+    FieldView base(*next->base), imp(*next->importance);
+    FieldView scalars(in.volume->normalized), fineImp(*in.importance);
+    TransferLookup tf = lookupOf(in.transfer);
+    const GridMap fineMap(fine);
+    const glm::vec3 offset = grid.spacing / 3.f;
+    exec::parallelFor("multigrid restrict", int64_t(grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
+      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+      float b = 0.f, g = 0.f;
+      for (int c = 0; c < 27; ++c) {
+        glm::vec3 o(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
+        glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)) + o * offset / map.spacing);
+        glm::vec3 fi = fineMap.toIndex(x);
+        b += tf.at(scalars.sample(fi)).w;
+        g += fineImp.sample(fi);
+      }
+      base.store(size_t(v), b / 27.f);
+      imp.store(size_t(v), g / 27.f);
+    });
+  }
+
+  if (level_ && level_->mu) {
+    // Prolong the previous level's mu (trilinear).
+    FieldView coarse(*level_->mu);
+    const GridMap coarseMap(level_->grid);
+    exec::parallelFor("multigrid prolong", int64_t(grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
+      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+      glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
+      mu.store(size_t(v), coarse.sample(coarseMap.toIndex(x)));
+    });
+  } else {
+    // Start from mu_bar.
+    BaseExtinction base;
+    if (next->base) base.field = FieldView(*next->base);
+    base.scalars = FieldView(in.volume->normalized);
+    base.transfer = lookupOf(in.transfer);
+    exec::parallelFor("extinction init", int64_t(grid.voxelCount()),
+                      [=] VISOPT_HD(int64_t v) { mu.store(size_t(v), base.at(size_t(v))); });
+  }
+  level_.reset();
+  level_ = std::move(next);
+  (void)s;
+}
+
+IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
+                                                 const ExtinctionSettings& s, int levels,
+                                                 int cap) {
+  Level& L = *level_;
+  const int shrink = 1 << (levels - 1 - L.index);
+  const Bounds bounds = in.volume->grid().worldBounds();
+  const float muMax = levelMuMax(in, s);
+
+  // Frustum grids for this level and the current camera and light.
+  const int w = std::max(4, int(float(in.imageWidth) * s.frustumScale) / shrink);
+  const int h = std::max(4, int(float(in.imageHeight) * s.frustumScale) / shrink);
+  L.view = FrustumGrid::forCamera(in.camera, w, h, bounds,
+                                  s.depthCells > 0 ? std::max(2, s.depthCells / shrink) : 0,
+                                  L.grid.minSpacing());
+  if (s.r != 0.f) {
+    const int n = std::max(4, s.lightGridSize / shrink);
+    L.light = FrustumGrid::forLight(in.light, bounds, glm::ivec3(n, n, 0), L.grid.minSpacing());
+  } else {
+    L.dLight.reset();  // model only what the scene needs
+  }
+
+  ExtinctionProblem p;
+  p.grid = L.grid;
+  p.mu = &*L.mu;
+  p.importance = L.finest ? in.importance : &*L.importance;
+  p.baseField = L.base ? &*L.base : nullptr;
+  p.scalars = &in.volume->normalized;
+  p.transfer = in.transfer;
+  p.rho = s.rho < 0.f ? 1.f / muMax : s.rho;
+  p.q = s.q;
+  p.r = s.r;
+  p.view = L.view;
+  p.light = L.light;
+
+  IterationStats st;
+  st.level = L.index;
+  auto t0 = Clock::now();
+  ScanSums view, light;
+  if (p.q != 0.f)
+    view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, L.dView,
+                    "view-derivative", precision_, ledger_);
+  else
+    L.dView.reset();
+  if (p.r != 0.f)
+    light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
+                     "light-derivative", precision_, ledger_);
+  st.gridUpdatesMs = msSince(t0);
+
+  // Optimiser state, allocated on the first step of a level.
+  const bool ademamix = s.optimizer == OptimizerKind::AdEMAMix;
+  if (!L.m1) {
+    L.m1.emplace("optimizer-m1", L.grid, precision_, ledger_);
+    L.rms.emplace("optimizer-rms", L.grid, precision_, ledger_);
+    L.m1->fill(0.f);
+    L.rms->fill(0.f);
+    if (ademamix) {
+      L.m2.emplace("optimizer-m2", L.grid, precision_, ledger_);
+      L.m2->fill(0.f);
+    }
+  }
+  L.t += 1;
+  const int t = L.t;
+  OptimizerCoefficients c;
+  c.ademamix = ademamix && L.m2.has_value();
+  c.lr = s.learningRate * muMax;
+  c.beta1 = s.beta1;
+  c.beta2 = s.beta2;
+  c.epsilon = s.epsilon;
+  c.biasCorrection1 = 1.f - std::pow(s.beta1, float(t));
+  c.biasCorrection2 = std::sqrt(1.f - std::pow(s.beta2, float(t)));
+  const int tAlpha = s.alphaWarmup > 0 ? s.alphaWarmup : cap;
+  const int tBeta3 = s.beta3Warmup > 0 ? s.beta3Warmup : cap;
+  c.alpha = s.alpha * std::min(1.f, float(t) / float(std::max(tAlpha, 1)));
+  if (t < tBeta3) {
+    // Linear interpolation in half-life space from beta1 to beta3 (METHODS.md §2).
+    auto halfLife = [](float b) { return std::log(0.5f) / std::log(b) - 1.f; };
+    const float f = float(t) / float(tBeta3);
+    const float hl = (1.f - f) * halfLife(s.beta1) + f * halfLife(s.beta3);
+    c.beta3 = std::pow(0.5f, 1.f / (hl + 1.f));
+  } else {
+    c.beta3 = s.beta3;
+  }
+
+  auto t1 = Clock::now();
+  ExtinctionStep step;
+  step.gradient = gradientOf(p, L.dView ? &*L.dView : nullptr, L.dLight ? &*L.dLight : nullptr);
+  step.state.m1 = FieldView(*L.m1);
+  step.state.rms = FieldView(*L.rms);
+  if (L.m2) step.state.m2 = FieldView(*L.m2);
+  step.coefficients = c;
+  step.muMax = muMax;
+  step.voxelVolume = voxelVolume(L.grid);
+  StepSums sums = exec::reduce("extinction step", int64_t(L.grid.voxelCount()), StepSums{}, step,
+                               [] VISOPT_HD(const StepSums& a, const StepSums& b) { return a + b; });
+  st.extinctionStepMs = msSince(t1);
+
+  st.iteration = t;
+  st.energyRho = sums.energyRho;
+  st.energyQ = -double(p.q) * view.gMuT;
+  st.energyR = -double(p.r) * light.gMuT;
+  st.visibilityView = view.gMu > 0 ? view.gMuT / view.gMu : 0.0;
+  st.visibilityLight = light.gMu > 0 ? light.gMuT / light.gMu : 0.0;
+  st.stepNorm = std::sqrt(sums.step2 / double(L.grid.voxelCount()));
+  return st;
+}
+
+namespace {
+void validate(const OptimizationInputs& in, const ExtinctionSettings& s) {
+  if (!in.volume || !in.importance || !in.transfer)
+    throw Error(ErrorKind::Usage, "optimisation needs a volume, an importance and a transfer function");
+  auto finite = [](float v) { return std::isfinite(v); };
+  if (!finite(s.q) || !finite(s.r) || !finite(s.rho) || s.q < 0.f || s.r < 0.f)
+    throw Error(ErrorKind::Usage, "q and r must be finite and non-negative, rho finite");
+  if (!finite(s.muMax) || s.muMax < 0.f) throw Error(ErrorKind::Usage, "mu_max must be >= 0");
+  if (!(s.learningRate > 0.f) || !finite(s.learningRate))
+    throw Error(ErrorKind::Usage, "the learning rate must be positive");
+  if (s.levels < 1 || s.levels > 8) throw Error(ErrorKind::Usage, "levels must be 1..8");
+  if (s.maxIterationsPerLevel < 1) throw Error(ErrorKind::Usage, "iterations must be >= 1");
+  if (!(s.frustumScale > 0.f) || s.frustumScale > 4.f)
+    throw Error(ErrorKind::Usage, "frustum scale must be in (0, 4]");
+  if (in.importance->grid().dims != in.volume->grid().dims)
+    throw Error(ErrorKind::Usage, "importance and volume grids differ");
+}
+}  // namespace
+
+std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const OptimizationInputs& in,
+                                                              const ExtinctionSettings& s,
+                                                              const IterationCallback& callback) {
+  validate(in, s);
+  level_.reset();
+  std::vector<IterationStats> all;
+  for (int l = 0; l < s.levels; ++l) {
+    buildLevel(in, s, l, s.levels);
+    double last = 0.0;
+    for (int it = 0; it < s.maxIterationsPerLevel; ++it) {
+      IterationStats st = runIteration(in, s, s.levels, s.maxIterationsPerLevel);
+      all.push_back(st);
+      if (callback && !callback(st)) return all;
+      const double e = st.energy();
+      const double rel = std::abs(e - last) / std::max(std::abs(e), 1e-30);
+      last = e;
+      if (it + 1 >= s.minIterationsPerLevel && rel < s.tolerance) break;
+    }
+  }
+  return all;
+}
+
+std::vector<IterationStats> ExtinctionOptimizer::iterate(const OptimizationInputs& in,
+                                                         const ExtinctionSettings& s,
+                                                         int iterations,
+                                                         const IterationCallback& callback) {
+  validate(in, s);
+  if (!level_ || !level_->finest || level_->grid.dims != in.volume->grid().dims)
+    buildLevel(in, s, 0, 1);  // start at the finest grid from mu_bar
+  std::vector<IterationStats> all;
+  for (int it = 0; it < iterations; ++it) {
+    IterationStats st = runIteration(in, s, 1, std::max(iterations, s.maxIterationsPerLevel));
+    st.level = level_->index;
+    all.push_back(st);
+    if (callback && !callback(st)) break;
+  }
+  return all;
+}
+
+}  // namespace visopt

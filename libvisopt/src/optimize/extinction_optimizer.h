@@ -1,0 +1,91 @@
+// Host orchestration of the extinction optimisation (paper 000 §II-C, Eqs. 10-14): the level
+// loop of the coarse-to-fine multigrid, the frustum grids, the optimiser state, statistics.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/device_buffer.h"
+#include "visopt/camera.h"
+#include "visopt/field.h"
+#include "visopt/frustum.h"
+#include "visopt/memory_ledger.h"
+#include "visopt/optimization.h"
+#include "visopt/volume.h"
+
+namespace visopt {
+
+struct OptimizationInputs {
+  const Volume* volume = nullptr;
+  const Field3D* importance = nullptr;                // g on the volume grid
+  const DeviceBuffer<glm::vec4>* transfer = nullptr;  // baked (albedo, extinction) table
+  float transferMaxExtinction = 0.f;
+  Camera camera;
+  PointLight light;
+  int imageWidth = 512, imageHeight = 512;
+};
+
+// Returning false from the callback stops the run after that iteration.
+using IterationCallback = std::function<bool(const IterationStats&)>;
+
+// The discrete problem on one grid; used by the optimiser and by the gradient tests.
+struct ExtinctionProblem {
+  GridSpec grid;
+  const Field3D* mu = nullptr;
+  const Field3D* importance = nullptr;
+  const Field3D* baseField = nullptr;  // mu_bar on `grid`, or null: TF of `scalars`
+  const Field3D* scalars = nullptr;
+  const DeviceBuffer<glm::vec4>* transfer = nullptr;
+  float rho = 1.f, q = 1.f, r = 0.f;
+  FrustumGrid view, light;
+};
+
+struct ProblemEvaluation {
+  double energyRho = 0.0, energyQ = 0.0, energyR = 0.0;
+  double visibilityView = 0.0, visibilityLight = 0.0;
+  double energy() const { return energyRho + energyQ + energyR; }
+};
+
+// The discrete energy of the problem (see kernels/visibility_scan.h for its definition).
+ProblemEvaluation evaluateProblem(const ExtinctionProblem& problem, Precision scratchPrecision);
+// The analytic gradient dE/dmu per unit volume at every voxel (multiply by the voxel volume for
+// the derivative of the discrete energy).
+std::vector<float> analyticGradient(const ExtinctionProblem& problem, Precision scratchPrecision);
+
+class ExtinctionOptimizer {
+ public:
+  ExtinctionOptimizer(MemoryLedger* ledger, Precision precision);
+  ~ExtinctionOptimizer();
+
+  // Coarse to fine from mu_bar: each level runs to its tolerance or iteration cap, then mu is
+  // prolonged to the next level; the optimiser state restarts at every level (its moments
+  // describe the coarse grid's gradients, which do not transfer).
+  std::vector<IterationStats> runMultigrid(const OptimizationInputs& in,
+                                           const ExtinctionSettings& settings,
+                                           const IterationCallback& callback);
+  // Continues at the finest level from the current mu (warm start, e.g. after the camera moved).
+  std::vector<IterationStats> iterate(const OptimizationInputs& in,
+                                      const ExtinctionSettings& settings, int iterations,
+                                      const IterationCallback& callback);
+  // The optimised extinction on the volume grid, or null before any run.
+  const Field3D* extinction() const;
+  void reset();
+
+ // Internal steps; public only because nvcc forbids extended device lambdas in private members.
+  struct Level;
+  void buildLevel(const OptimizationInputs& in, const ExtinctionSettings& settings, int level,
+                  int levels);
+  IterationStats runIteration(const OptimizationInputs& in, const ExtinctionSettings& settings,
+                              int levels, int cap);
+
+ private:
+  MemoryLedger* ledger_;
+  Precision precision_;
+  std::unique_ptr<Level> level_;
+};
+
+}  // namespace visopt

@@ -13,8 +13,14 @@
 //   dense  the same with every opacity raised to at least kDenseOpacityFloor, so there is no
 //          empty space to skip and (almost) every nominal sample is taken by both renderers.
 // Counters (per frame, averaged over the iterations):
-//   Msps_core        nominal samples / second / thread, in millions (the headline figure)
-//   Msps_core_taken  visopt only: samples actually taken (RenderStats::samples) / s / thread
+//   Msps_core        nominal samples / wall second / thread, in millions
+//   Msps_core_cpu    nominal samples / CPU second of the whole process (all threads), in
+//                    millions: per core-second actually used, so robust against other load on a
+//                    shared machine (where the wall-clock figure understates both renderers)
+//   cpu_util         CPU seconds / (wall seconds * threads): the share of the cores obtained
+//   Msps_core_taken, Msps_core_taken_cpu
+//                    visopt only: samples actually taken (RenderStats::samples), per wall / CPU
+//                    second as above
 //   ms_frame         wall time of one frame (the time the benchmark reports, too)
 //   mapper_ms        VTK only: the mapper's own ray-casting time for the frame
 //   Msps_core_mapper VTK only: nominal samples / mapper_ms / thread
@@ -63,6 +69,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <time.h>
+
 #include "visopt/engine.h"
 #include "visopt/exec.h"
 #include "visopt/image.h"
@@ -105,6 +113,31 @@ std::string dumpDir() {
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// CPU time consumed so far by all threads of this process.
+double processCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+// Wall time and process CPU time of the timed part of a benchmark.
+struct Timing {
+  double wall = 0.0, cpu = 0.0;
+};
+
+// Counters common to both renderers, from the nominal sample count of one frame.
+void setCounters(benchmark::State& state, const Timing& t, int64_t nominalPerFrame,
+                 double threads) {
+  const double frames = static_cast<double>(state.iterations());
+  const double samples = static_cast<double>(nominalPerFrame) * frames;
+  state.counters["Msps_core"] = samples / t.wall / threads * 1e-6;
+  state.counters["Msps_core_cpu"] = samples / t.cpu * 1e-6;
+  state.counters["cpu_util"] = t.cpu / (t.wall * threads);
+  state.counters["ms_frame"] = t.wall / frames * 1e3;
+  state.counters["threads"] = threads;
+  state.counters["nominal_Msamples"] = static_cast<double>(nominalPerFrame) * 1e-6;
 }
 
 // Sample distance of both renderers: one smallest voxel spacing.
@@ -208,26 +241,24 @@ void benchVisopt(benchmark::State& state, int size, int image, TfVariant variant
         nominalSamples(c.engine->camera(), image, image, grid.worldBounds(), sampleDistance(grid));
     const double threads = tbb::info::default_concurrency();
 
-    double seconds = 0.0;
+    Timing t;
     int64_t taken = 0;
     for (auto _ : state) {
       visopt::RenderStats stats;
+      const double cpu0 = processCpuSeconds();
       const auto start = Clock::now();
       visopt::Image img = c.engine->render(settings, &stats);
       const double s = secondsSince(start);
+      t.cpu += processCpuSeconds() - cpu0;
       benchmark::DoNotOptimize(img.pixels.data());
       state.SetIterationTime(s);
-      seconds += s;
+      t.wall += s;
       taken += stats.samples;
     }
-    const double frames = static_cast<double>(state.iterations());
-    const double nominalPerFrame = static_cast<double>(nominal);
-    state.counters["Msps_core"] = nominalPerFrame * frames / seconds / threads * 1e-6;
-    state.counters["Msps_core_taken"] = static_cast<double>(taken) / seconds / threads * 1e-6;
-    state.counters["ms_frame"] = seconds / frames * 1e3;
+    setCounters(state, t, nominal, threads);
+    state.counters["Msps_core_taken"] = static_cast<double>(taken) / t.wall / threads * 1e-6;
+    state.counters["Msps_core_taken_cpu"] = static_cast<double>(taken) / t.cpu * 1e-6;
     state.counters["light_ms"] = c.lightMs;
-    state.counters["threads"] = threads;
-    state.counters["nominal_Msamples"] = nominalPerFrame * 1e-6;
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
   }
@@ -384,24 +415,24 @@ void benchVtk(benchmark::State& state, int size, int image, TfVariant variant) {
         nominalSamples(c.camera, image, image, c.grid.worldBounds(), sampleDistance(c.grid));
     const double threads = c.mapper->GetNumberOfThreads();
 
-    double seconds = 0.0, mapperSeconds = 0.0;
+    Timing t;
+    double mapperSeconds = 0.0;
     for (auto _ : state) {
+      const double cpu0 = processCpuSeconds();
       const auto start = Clock::now();
       c.window->Render();
       const double s = secondsSince(start);
+      t.cpu += processCpuSeconds() - cpu0;
       state.SetIterationTime(s);
-      seconds += s;
+      t.wall += s;
       mapperSeconds += static_cast<double>(c.mapper->GetEstimatedRenderTime(c.renderer, c.volume));
     }
+    setCounters(state, t, nominal, threads);
     const double frames = static_cast<double>(state.iterations());
-    const double nominalPerFrame = static_cast<double>(nominal);
-    state.counters["Msps_core"] = nominalPerFrame * frames / seconds / threads * 1e-6;
     state.counters["Msps_core_mapper"] =
-        mapperSeconds > 0.0 ? nominalPerFrame * frames / mapperSeconds / threads * 1e-6 : 0.0;
-    state.counters["ms_frame"] = seconds / frames * 1e3;
+        mapperSeconds > 0.0 ? static_cast<double>(nominal) * frames / mapperSeconds / threads * 1e-6
+                            : 0.0;
     state.counters["mapper_ms"] = mapperSeconds / frames * 1e3;
-    state.counters["threads"] = threads;
-    state.counters["nominal_Msamples"] = nominalPerFrame * 1e-6;
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
   }

@@ -102,24 +102,27 @@ print(f"scene {ctx.get('scene', '?')}; visopt {ctx.get('visopt_backend', '?')}; 
       f"VTK mapper threads {ctx.get('vtk_threads', '?')}; {ctx.get('num_cpus', '?')} CPUs; "
       f"load average at start {', '.join(f'{x:.2f}' for x in ctx.get('load_avg', []))}")
 print()
-print("| volume | image | TF | precision | visopt Msamples/s/core | (samples taken) "
-      "| VTK Msamples/s/core | (ray cast only) | ratio visopt/VTK | visopt ms/frame "
-      "| VTK ms/frame | T_L ms |")
-print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+print("| volume | image | TF | precision "
+      "| visopt Msamples/s/core | VTK Msamples/s/core | ratio "
+      "| visopt Msamples/CPU-s | VTK Msamples/CPU-s | ratio (CPU) "
+      "| visopt taken Msamples/CPU-s | visopt ms/frame | VTK ms/frame | CPU share visopt / VTK "
+      "| T_L ms |")
+print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 keys = sorted({k for k in runs if k[0] == "visopt"} | {k for k in errors if k[0] == "visopt"},
               key=lambda k: (k[1], k[2], k[3] != "scene", k[4] != "fp32"))
 for key in keys:
     _, size, image, tf, precision = key
     vtk = ("vtk_fixed_point", size, image, tf, "")
-    ours = median(key, "Msps_core")
-    theirs = median(vtk, "Msps_core")
-    ratio = ours / theirs if ours and theirs else None
-    vtk_cell = fmt(theirs) if vtk not in errors else "skipped"
-    print(f"| {size}³ | {image}² | {tf} | {precision} | {fmt(ours)} | "
-          f"{fmt(median(key, 'Msps_core_taken'))} | {vtk_cell} | "
-          f"{fmt(median(vtk, 'Msps_core_mapper'))} | {fmt(ratio, 2)} | "
-          f"{fmt(median(key, 'ms_frame'), 0)} | {fmt(median(vtk, 'ms_frame'), 0)} | "
-          f"{fmt(median(key, 'light_ms'), 0)} |")
+    cells = [f"{size}³", f"{image}²", tf, precision]
+    for counter in ("Msps_core", "Msps_core_cpu"):
+        ours, theirs = median(key, counter), median(vtk, counter)
+        cells += [fmt(ours), "skipped" if vtk in errors else fmt(theirs),
+                  fmt(ours / theirs if ours and theirs else None, 2)]
+    cells += [fmt(median(key, "Msps_core_taken_cpu")), fmt(median(key, "ms_frame"), 0),
+              fmt(median(vtk, "ms_frame"), 0),
+              f"{fmt(median(key, 'cpu_util'), 2)} / {fmt(median(vtk, 'cpu_util'), 2)}",
+              fmt(median(key, "light_ms"), 0)]
+    print("| " + " | ".join(cells) + " |")
 for key, message in sorted(errors.items()):
     print(f"\n{'/'.join(str(k) for k in key if k != '')}: {message}")
 PY

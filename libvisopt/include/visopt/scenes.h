@@ -24,7 +24,11 @@ struct BuiltinScene {
   TransferFunction transferFunction;
   // Default view as an orbit around the volume centre (distance in bounding-sphere radii).
   float azimuthDeg = 0.f, elevationDeg = 0.f, distanceInRadii = 3.f;
-  // The importance curve over normalised values, for later issues: points (t, g).
+  // What the user should see, from the scene's own definition: g(x) in [0, 1] on the volume's
+  // grid (field name "importance"), e.g. a soft indicator of the tumours. Always present.
+  Field3D importance;
+  // The same structures as a curve over normalised values, points (t, g) — what a user could
+  // set in an importance editor; may also catch edges that pass through the same values.
   std::vector<glm::vec2> importanceCurve;
 };
 

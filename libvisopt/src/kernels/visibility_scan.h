@@ -4,7 +4,7 @@
 // The discrete energy (the ground truth the gradient is checked against) is
 //   E = rho/2 sum_v (mu_v - mubar_v)^2 dV  -  q sum_c g_c mu_c T_c dV_c  -  r (same on the light grid)
 // over object voxels v and frustum cells c, with mu_c, g_c trilinear samples at the cell centres
-// (zero outside the volume's box), exclusive transmittance T_c = exp(-sum_{j<k} mu_j ds) along the
+// (zero outside the volume's cells), exclusive transmittance T_c = exp(-sum_{j<k} mu_j ds) along the
 // cell's ray, and the cell volume dV_c = Omega_ij s_k^2 ds (Omega_ij: the pixel's solid angle).
 //
 // dE/dmu at a cell, per unit volume, is -q d_c with
@@ -51,8 +51,11 @@ struct VisibilityScan {
   // mu and g at a cell centre; zero outside the volume's box.
   VISOPT_HD VISOPT_INLINE bool sampleAt(int i, int j, int k, float& m, float& g) const {
     const glm::vec3 idx = volume.toIndex(frustum.toWorld(glm::vec3(float(i), float(j), float(k))));
-    const glm::vec3 hi = glm::vec3(volume.dims - 1);
-    if (idx.x < 0.f || idx.y < 0.f || idx.z < 0.f || idx.x > hi.x || idx.y > hi.y || idx.z > hi.z) {
+    // The volume occupies its voxels' cells, [-0.5, dims - 0.5] in index space (sampling clamps
+    // beyond the outer voxel centres), so every voxel, boundary voxels included, is covered by
+    // frustum cells in proportion to its volume, as the gather in extinction_step.h assumes.
+    const glm::vec3 lo(-0.5f), hi = glm::vec3(volume.dims) - 0.5f;
+    if (idx.x < lo.x || idx.y < lo.y || idx.z < lo.z || idx.x > hi.x || idx.y > hi.y || idx.z > hi.z) {
       m = g = 0.f;
       return false;
     }

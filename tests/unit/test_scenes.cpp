@@ -1,6 +1,8 @@
 // Built-in scenes: every scene builds, is deterministic and finite; Shepp–Logan and
-// Marschner–Lobb match their analytic definitions; the default scene hides what it marks
-// important behind an opaque shell.
+// Marschner–Lobb match their analytic definitions; every scene's importance field is a sane
+// soft indicator of its structures (for Shepp–Logan the tumours and nothing of the shell), and
+// the default view sees what is important through something opaque.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -11,7 +13,9 @@
 #include "core/field_view.h"
 #include "scenes/scene_common.h"
 #include "scenes/shepp_logan.h"
+#include "visopt/camera.h"
 #include "visopt/error.h"
+#include "visopt/memory_ledger.h"
 #include "visopt/scenes.h"
 
 using namespace visopt;
@@ -50,6 +54,42 @@ double transmittance(const BuiltinScene& scene, glm::vec3 a, glm::vec3 b, float 
            (len / float(steps));
   }
   return std::exp(-tau);
+}
+
+// Mean over the important voxels (g > 0.5, weighted by g) of the transmittance from the default
+// eye to the voxel through the scene's TF, counting only material that is not itself important
+// (g < 0.05), so it measures how much of the important structure something else hides.
+double meanOcclusionTransmittance(const BuiltinScene& scene) {
+  const FieldView vol(scene.volume.normalized), imp(scene.importance);
+  const GridSpec& g = scene.volume.grid();
+  const Camera cam = Camera::orbitBounds(g.worldBounds(), scene.azimuthDeg, scene.elevationDeg,
+                                         scene.distanceInRadii);
+  const float ds = 0.5f * g.minSpacing();
+  double sumT = 0.0, sumW = 0.0;
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = 0; j < g.dims.y; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const float weight = imp.at(i, j, k);
+        if (weight <= 0.5f) continue;
+        const glm::vec3 target = g.indexToWorld(glm::vec3(i, j, k));
+        const float len = glm::length(target - cam.eye);
+        const int steps = int(std::ceil(len / ds));
+        double tau = 0.0;
+        for (int s = 0; s < steps; ++s) {
+          const glm::vec3 p = cam.eye + (target - cam.eye) * ((float(s) + 0.5f) / float(steps));
+          const glm::vec3 idx = g.worldToIndex(p);
+          if (glm::any(glm::lessThan(idx, glm::vec3(0.f))) ||
+              glm::any(glm::greaterThan(idx, glm::vec3(g.dims - 1))))
+            continue;
+          if (imp.sample(idx) >= 0.05f) continue;
+          tau += scene.transferFunction.extinctionAt(scene.volume.toValue(vol.sample(idx)),
+                                                     g.minSpacing()) *
+                 (len / float(steps));
+        }
+        sumT += weight * std::exp(-tau);
+        sumW += weight;
+      }
+  return sumW > 0.0 ? sumT / sumW : 1.0;
 }
 
 }  // namespace
@@ -139,6 +179,121 @@ TEST(Scenes, EverySceneBuildsSaneAndDeterministic) {
       }
     }
   }
+}
+
+TEST(Scenes, EverySceneHasASaneDeterministicImportanceField) {
+  for (const auto& desc : builtinScenes()) {
+    for (int res : {32, 64}) {
+      SCOPED_TRACE(desc.name + " @ " + std::to_string(res));
+      const BuiltinScene a = makeBuiltinScene(desc.name, res, Precision::FP32);
+      const BuiltinScene b = makeBuiltinScene(desc.name, res, Precision::FP32);
+      const Field3D& g = a.importance;
+      ASSERT_FALSE(g.empty());
+      EXPECT_EQ(g.name(), "importance");
+      EXPECT_EQ(g.grid(), a.volume.grid());
+      EXPECT_EQ(g.precision(), Precision::FP32);
+      ASSERT_EQ(g.size(), b.importance.size());
+      size_t marked = 0, differing = 0;
+      for (size_t i = 0; i < g.size(); ++i) {
+        const float v = g.get(i);
+        ASSERT_TRUE(std::isfinite(v)) << i;
+        ASSERT_GE(v, 0.f) << i;
+        ASSERT_LE(v, 1.f) << i;
+        if (v > 0.5f) ++marked;
+        if (v != b.importance.get(i)) ++differing;
+      }
+      EXPECT_EQ(differing, 0u);
+      const double fraction = double(marked) / double(g.size());
+      EXPECT_GT(fraction, 0.0005);
+      EXPECT_LT(fraction, 0.3);
+    }
+  }
+}
+
+TEST(Scenes, ImportanceIsStoredLikeTheVolumeAndListedInTheLedger) {
+  for (const auto& desc : builtinScenes()) {
+    SCOPED_TRACE(desc.name);
+    MemoryLedger ledger;
+    {
+      const BuiltinScene scene = makeBuiltinScene(desc.name, 16, Precision::FP16, &ledger);
+      EXPECT_EQ(scene.importance.precision(), Precision::FP16);
+      EXPECT_EQ(scene.importance.grid(), scene.volume.grid());
+      bool listed = false;
+      for (const LedgerEntry& e : ledger.entries())
+        if (e.name == "importance") {
+          listed = true;
+          EXPECT_EQ(e.bytes, scene.importance.bytes());
+          EXPECT_EQ(e.precision, "fp16");
+        }
+      EXPECT_TRUE(listed);
+      const BuiltinScene full = makeBuiltinScene(desc.name, 16, Precision::FP32);
+      for (size_t i = 0; i < full.importance.size(); ++i)
+        ASSERT_NEAR(full.importance.get(i), scene.importance.get(i), 1e-3f);
+    }
+    EXPECT_TRUE(ledger.entries().empty());  // freed with the scene
+  }
+}
+
+TEST(Scenes, SheppLoganImportanceIsTheTumoursAndNothingOfTheShell) {
+  const auto& table = scenes::sheppLoganEllipsoids();
+  const scenes::SoftEllipsoid outer(table[0].center, table[0].semiAxes, table[0].angleDeg);
+  const scenes::SoftEllipsoid brain(table[1].center, table[1].semiAxes, table[1].angleDeg);
+  for (int res : {32, 64, 128}) {
+    SCOPED_TRACE(res);
+    const BuiltinScene scene = makeBuiltinScene("shepp-logan", res, Precision::FP32);
+    const GridSpec& g = scene.importance.grid();
+    const FieldView imp(scene.importance);
+    const auto at = [&](glm::vec3 normalised) {
+      return imp.sample(g.worldToIndex(normalised * 100.f));
+    };
+    // ~1 at every tumour's centre (rows 4..9 of the table), even the sub-voxel ones.
+    for (size_t n = 4; n < table.size(); ++n) EXPECT_GT(at(table[n].center), 0.95f) << n;
+    // 0 in the ventricles, the brain away from the tumours and the air.
+    EXPECT_EQ(at(table[2].center), 0.f);
+    EXPECT_EQ(at(table[3].center), 0.f);
+    EXPECT_EQ(at({0.f, -0.3f, -0.3f}), 0.f);
+    EXPECT_EQ(at({0.f, 0.f, 0.95f}), 0.f);
+    // Exactly 0 at every voxel of the shell, its faces and outside it: all voxels within two
+    // voxels of the brain's surface or beyond (the value-based curve marks both faces there).
+    const float w = scenes::edgeHalfWidth(g);
+    size_t shellVoxels = 0;
+    for (int k = 0; k < g.dims.z; ++k)
+      for (int j = 0; j < g.dims.y; ++j)
+        for (int i = 0; i < g.dims.x; ++i) {
+          const glm::vec3 p = g.indexToWorld(glm::vec3(i, j, k)) / 100.f;
+          if (brain.distance(p) <= -2.f * w) continue;
+          if (outer.distance(p) < 2.f * w) ++shellVoxels;
+          ASSERT_EQ(imp.at(i, j, k), 0.f) << i << " " << j << " " << k;
+        }
+    EXPECT_GT(shellVoxels, 0u);
+    // Along rays from the centre outward through the shell (interpolated between voxels): 0 from
+    // the shell's inner face to beyond its outer face, where the value crosses 0.3 twice.
+    const std::vector<glm::vec3> dirs = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},  {0, -1, 0},
+                                         {0, 0, 1},  {0, 0, -1}, {1, 1, 1},  {-1, 1, -1},
+                                         {1, -1, 1}, {0, 1, -1}, {1, -2, 0}, {-2, 0, 1}};
+    for (glm::vec3 dir : dirs) {
+      dir = glm::normalize(dir);
+      int shellSamples = 0;
+      for (float t = 0.f; t < 1.f; t += 0.002f) {
+        const glm::vec3 p = t * dir;
+        if (brain.distance(p) < -0.25f * w || outer.distance(p) > 2.f * w) continue;
+        ++shellSamples;
+        ASSERT_EQ(at(p), 0.f) << "dir " << dir.x << " " << dir.y << " " << dir.z << " t " << t;
+      }
+      EXPECT_GT(shellSamples, 10);
+    }
+  }
+}
+
+// From 48^3 up (the CLI's default is 128^3); at 32^3 a voxel (6.5 mm) is wider than the mixer's
+// wall and the mantle's crust, whose smoothed profiles then no longer reach opaque values.
+TEST(Scenes, DefaultViewsSeeTheImportantThroughSomethingOpaque) {
+  for (const auto& desc : builtinScenes())
+    for (int res : {48, 64, 128}) {
+      SCOPED_TRACE(desc.name + " @ " + std::to_string(res));
+      const BuiltinScene scene = makeBuiltinScene(desc.name, res, Precision::FP32);
+      EXPECT_LT(meanOcclusionTransmittance(scene), 0.3);
+    }
 }
 
 TEST(Scenes, Fp16StorageMatchesFp32) {

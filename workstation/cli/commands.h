@@ -13,5 +13,6 @@ using Runner = std::function<int()>;
 Runner addInfoCommand(CLI::App& app);
 Runner addScenesCommand(CLI::App& app);
 Runner addRenderCommand(CLI::App& app);
+Runner addOptimizeCommand(CLI::App& app);
 
 }  // namespace visopt::cli

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   add(addInfoCommand, "info", "Describe a volume file: dims, spacing, origin, type, range, memory");
   add(addScenesCommand, "scenes", "List the built-in scenes");
   add(addRenderCommand, "render", "Render a volume or built-in scene to a PNG");
+  add(addOptimizeCommand, "optimize", "Optimise the extinction so the important parts show");
 
   try {
     app.parse(argc, argv);

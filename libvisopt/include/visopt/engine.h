@@ -2,14 +2,18 @@
 // fields and the order of the stages; a user of the library never touches a kernel.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include <glm/glm.hpp>
 
 #include "visopt/camera.h"
 #include "visopt/exec.h"
 #include "visopt/image.h"
 #include "visopt/memory_ledger.h"
+#include "visopt/optimization.h"
 #include "visopt/precision.h"
 #include "visopt/progress.h"
 #include "visopt/render_settings.h"
@@ -45,6 +49,35 @@ class Engine {
   void orbitCamera(float azimuthDeg, float elevationDeg, float distanceInRadii);
   void setLight(const PointLight& light);
   const PointLight& light() const;
+
+  // ---- importance g(x) in [0, 1] (paper 000 §III-A) ----
+  // A piecewise-linear curve over data values: points (value, g), g in [0, 1].
+  void setImportanceCurve(const std::vector<glm::dvec2>& points, const std::string& origin = "importance curve");
+  // A JSON curve file ({"points": [[value, g], ...]} or a visopt transfer function whose opacity
+  // is read as g) or a volume file on the same grid with values in [0, 1].
+  void loadImportance(const std::string& path);
+  bool hasImportance() const;
+  const Field3D* importance() const;
+
+  // ---- extinction optimisation (paper 000 §II-C, Eqs. 10-14) ----
+  void setExtinctionSettings(const ExtinctionSettings& settings);
+  const ExtinctionSettings& extinctionSettings() const;
+  // The frustum grids follow this image size (set it to the render size).
+  void setViewportSize(int width, int height);
+  // Coarse to fine from mu_bar. The callback sees every iteration; returning false stops.
+  std::vector<IterationStats> optimize(const std::function<bool(const IterationStats&)>& callback = {});
+  // Continues at the finest level from the current mu, for the current camera and light (warm
+  // start: what the workstation runs while the user navigates). Does nothing while frozen.
+  std::vector<IterationStats> continueOptimization(
+      int iterations, const std::function<bool(const IterationStats&)>& callback = {});
+  // A frozen result keeps its mu when the camera moves (paper 000 §III-F, Fig. 7).
+  void setFrozen(bool frozen);
+  bool frozen() const;
+  void resetOptimization();
+  bool hasOptimizedExtinction() const;
+  const Field3D* optimizedExtinction() const;
+  // Render with the optimised mu (default when there is one) or with the transfer function's mu_bar.
+  void setRenderOptimized(bool useOptimized);
 
   // Renders the current scene. T_L is recomputed only when the light, the transfer function,
   // the volume or the light grid size changed since the last render.

@@ -14,7 +14,7 @@ struct ExtinctionSettings {
   // Energy weights: F = rho/2 ∫(mu - mu_bar)^2 - q ∫ g mu T_V - r ∫ g mu T_L (Eqs. 11-13).
   // rho < 0 means "1 / mu_max", which makes rho (mu - mu_bar) a number in [-1, 1].
   float rho = -1.f;
-  float q = 1.f;
+  float q = 40.f;  // large: q G must outweigh rho mu_bar behind a dense occluder (G ~ T_occluder)
   float r = 0.f;   // 0: no light term, and no light-space grids are allocated
   float muMax = 0.f;  // upper bound of Eq. 14 (1 / world unit); 0: the transfer function's maximum
 

@@ -4,6 +4,8 @@
 #include <optional>
 
 #include "core/device_buffer.h"
+#include "engine/importance.h"
+#include "optimize/extinction_optimizer.h"
 #include "render/renderer.h"
 #include "visopt/error.h"
 #include "visopt/frustum.h"
@@ -24,12 +26,44 @@ struct Engine::Impl {
   DeviceBuffer<glm::vec4> table;
   bool tableDirty = true;
   int tableToken = 0;
+  float tableMaxExtinction = 0.f;
   FrustumGrid lightFrustum;
   std::optional<Field3D> lightTransmittance;
   bool lightDirty = true;
   int lightGridSize = 0, lightGridDepth = -1;
 
-  explicit Impl(Precision p) : precision(p) {}
+  std::optional<Field3D> importance;
+  ExtinctionSettings extinctionSettings;
+  ExtinctionOptimizer optimizer{&ledger, Precision::FP32};
+  bool frozen = false;
+  bool renderOptimized = true;
+  int viewportWidth = 512, viewportHeight = 512;
+
+  explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
+
+  void clearScene() {
+    optimizer.reset();
+    importance.reset();
+    volume.reset();
+    frozen = false;
+  }
+
+  OptimizationInputs optimizationInputs() {
+    if (!volume) throw Error(ErrorKind::Usage, "no volume loaded");
+    if (!importance)
+      throw Error(ErrorKind::Usage, "no importance: give an importance curve or volume first");
+    ensureTable();
+    OptimizationInputs in;
+    in.volume = &*volume;
+    in.importance = &*importance;
+    in.transfer = &table;
+    in.transferMaxExtinction = tableMaxExtinction;
+    in.camera = camera;
+    in.light = light;
+    in.imageWidth = viewportWidth;
+    in.imageHeight = viewportHeight;
+    return in;
+  }
 
   void invalidateAll() {
     tableDirty = true;
@@ -52,6 +86,7 @@ struct Engine::Impl {
     table = DeviceBuffer<glm::vec4>(baked.albedoExtinction.size());
     for (size_t i = 0; i < table.size(); ++i) table[i] = baked.albedoExtinction[i];
     tableToken = ledger.add("transfer-table", table.bytes(), "fp32");
+    tableMaxExtinction = baked.maxExtinction;
     tableDirty = false;
     lightDirty = true;
   }
@@ -62,6 +97,7 @@ struct Engine::Impl {
     s.transfer = &table;
     s.camera = camera;
     s.light = light;
+    if (renderOptimized) s.extinction = optimizer.extinction();
     if (lightTransmittance) {
       s.lightFrustum = &lightFrustum;
       s.lightTransmittance = &*lightTransmittance;
@@ -99,7 +135,7 @@ Engine::~Engine() = default;
 Precision Engine::precision() const { return impl_->precision; }
 
 void Engine::loadVolume(const std::string& path, const ProgressCallback& progress) {
-  impl_->volume.reset();
+  impl_->clearScene();
   impl_->volume.emplace(readVolume(path, impl_->precision, &impl_->ledger, progress));
   impl_->hasTf = false;
   impl_->invalidateAll();
@@ -107,9 +143,14 @@ void Engine::loadVolume(const std::string& path, const ProgressCallback& progres
 }
 
 void Engine::loadBuiltinScene(const std::string& name, int resolution) {
-  impl_->volume.reset();
+  impl_->clearScene();
   BuiltinScene scene = makeBuiltinScene(name, resolution, impl_->precision, &impl_->ledger);
   impl_->volume.emplace(std::move(scene.volume));
+  if (!scene.importance.empty())
+    impl_->importance.emplace(std::move(scene.importance));
+  else if (!scene.importanceCurve.empty())
+    impl_->importance.emplace(importanceFromNormalizedCurve(*impl_->volume, scene.importanceCurve,
+                                                            impl_->precision, &impl_->ledger));
   impl_->tf = std::move(scene.transferFunction);
   impl_->hasTf = true;
   impl_->invalidateAll();
@@ -117,7 +158,7 @@ void Engine::loadBuiltinScene(const std::string& name, int resolution) {
 }
 
 void Engine::setVolume(Volume volume) {
-  impl_->volume.reset();
+  impl_->clearScene();
   impl_->volume.emplace(std::move(volume));
   impl_->hasTf = false;
   impl_->invalidateAll();
@@ -136,6 +177,7 @@ void Engine::setTransferFunction(TransferFunction tf) {
   impl_->tf = std::move(tf);
   impl_->hasTf = true;
   impl_->tableDirty = true;
+  impl_->optimizer.reset();  // mu_bar changed: the optimised mu no longer applies
 }
 
 const TransferFunction& Engine::transferFunction() const {
@@ -171,5 +213,75 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
 }
 
 const MemoryLedger& Engine::ledger() const { return impl_->ledger; }
+
+void Engine::setImportanceCurve(const std::vector<glm::dvec2>& points, const std::string& origin) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its importance");
+  impl_->importance.reset();
+  impl_->importance.emplace(importanceFromCurve(*impl_->volume, points, origin, impl_->precision,
+                                                &impl_->ledger));
+  impl_->optimizer.reset();
+}
+
+void Engine::loadImportance(const std::string& path) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its importance");
+  if (isCurveFile(path)) {
+    setImportanceCurve(readImportanceCurve(path), path);
+    return;
+  }
+  Field3D g = importanceFromVolumeFile(*impl_->volume, path, impl_->precision, &impl_->ledger);
+  impl_->importance.reset();
+  impl_->importance.emplace(std::move(g));
+  impl_->optimizer.reset();
+}
+
+bool Engine::hasImportance() const { return impl_->importance.has_value(); }
+const Field3D* Engine::importance() const {
+  return impl_->importance ? &*impl_->importance : nullptr;
+}
+
+void Engine::setExtinctionSettings(const ExtinctionSettings& settings) {
+  impl_->extinctionSettings = settings;
+}
+const ExtinctionSettings& Engine::extinctionSettings() const { return impl_->extinctionSettings; }
+
+void Engine::setViewportSize(int width, int height) {
+  if (width <= 0 || height <= 0) throw Error(ErrorKind::Usage, "viewport size must be positive");
+  impl_->viewportWidth = width;
+  impl_->viewportHeight = height;
+}
+
+std::vector<IterationStats> Engine::optimize(
+    const std::function<bool(const IterationStats&)>& callback) {
+  if (impl_->frozen) return {};
+  auto stats =
+      impl_->optimizer.runMultigrid(impl_->optimizationInputs(), impl_->extinctionSettings, callback);
+  impl_->lightDirty = true;
+  return stats;
+}
+
+std::vector<IterationStats> Engine::continueOptimization(
+    int iterations, const std::function<bool(const IterationStats&)>& callback) {
+  if (impl_->frozen || iterations <= 0) return {};
+  auto stats = impl_->optimizer.iterate(impl_->optimizationInputs(), impl_->extinctionSettings,
+                                        iterations, callback);
+  impl_->lightDirty = true;
+  return stats;
+}
+
+void Engine::setFrozen(bool frozen) { impl_->frozen = frozen; }
+bool Engine::frozen() const { return impl_->frozen; }
+
+void Engine::resetOptimization() {
+  impl_->optimizer.reset();
+  impl_->lightDirty = true;
+}
+
+bool Engine::hasOptimizedExtinction() const { return impl_->optimizer.extinction() != nullptr; }
+const Field3D* Engine::optimizedExtinction() const { return impl_->optimizer.extinction(); }
+
+void Engine::setRenderOptimized(bool useOptimized) {
+  if (impl_->renderOptimized != useOptimized) impl_->lightDirty = true;
+  impl_->renderOptimized = useOptimized;
+}
 
 }  // namespace visopt

@@ -122,6 +122,7 @@ struct ExtinctionOptimizer::Level {
   std::optional<Field3D> m1, m2, rms;
   std::optional<Field3D> dView, dLight;
   FrustumGrid view, light;
+  int shrink = 1;  // frustum grids are this many times coarser than at the finest level
   int t = 0;  // optimiser steps taken on this level
   double lastEnergy = 0.0;
 };
@@ -164,6 +165,7 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
   next->index = index;
   next->finest = index == levels - 1;
   next->grid = levelGrid(fine, factor);
+  next->shrink = factor;
   const GridSpec grid = next->grid;
   next->mu.emplace("extinction", grid, precision_, ledger_);
   FieldView mu(*next->mu);
@@ -222,7 +224,8 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
                                                  const ExtinctionSettings& s, int levels,
                                                  int cap) {
   Level& L = *level_;
-  const int shrink = 1 << (levels - 1 - L.index);
+  const int shrink = L.shrink;
+  (void)levels;
   const Bounds bounds = in.volume->grid().worldBounds();
   const float muMax = levelMuMax(in, s);
 

@@ -92,6 +92,21 @@ BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* 
         return v * softInside(r - kCrustOuter, w);
       });
 
+  // Importance: the cold material, i.e. the union of the slabs and blobs with the same soft
+  // edges, less where the core and the crust overwrite it (as in the volume above).
+  scene.importance = generateImportance(grid, precision, ledger, [=](glm::vec3 p) {
+    const float r = glm::length(p);
+    if (r > kCrustInner + 0.02f + 2.f * w) return 0.f;
+    const glm::vec3 dir = r > 1e-6f ? p / r : glm::vec3(0.f, 0.f, 1.f);
+    float warm = 1.f;  // the fraction not covered by any cold body
+    for (const Slab& s : slabs) warm *= 1.f - s.inside(dir, r, ws);
+    for (const SoftEllipsoid& e : blobs) warm *= 1.f - softInside(e.distance(p), ws);
+    const float crustHalf = 0.5f * (kCrustOuter - kCrustInner);
+    const float core = softInside(r - kCoreRadius, w);
+    const float crust = softInside(std::abs(r - (kCrustOuter - crustHalf)) - crustHalf, w);
+    return (1.f - warm) * (1.f - core) * (1.f - crust);
+  });
+
   TransferFunction& tf = scene.transferFunction;
   tf.name = "earth-mantle";
   tf.unitDistance = 2.f;  // mm

@@ -10,22 +10,36 @@
 namespace visopt::scenes {
 
 namespace {
-constexpr float kBohrPerUnit = 20.f;
+
+constexpr double kBohrPerUnit = 20.0;
+// The lobes' marked core: density above this fraction of the peak (the torus peaks at 1/4).
+constexpr double kLobeLevel = 0.4;
+
+// |psi_320|^2 at p (normalised coordinates) divided by its maximum. The maximum of
+// r^4 exp(-2r/3) is at r = 6; (3 cos^2 - 1)^2 peaks at 4 on the z axis.
+double orbitalDensity(glm::dvec3 p) {
+  const double peak = 4.0 * 1296.0 * std::exp(-4.0);
+  const glm::dvec3 q = p * kBohrPerUnit;
+  const double r2 = glm::dot(q, q);
+  const double angular = 3.0 * q.z * q.z - r2;  // r^2 (3 cos^2 - 1)
+  return angular * angular * std::exp(-2.0 * std::sqrt(r2) / 3.0) / peak;
 }
+
+}  // namespace
 
 BuiltinScene makeHydrogen(int resolution, Precision precision, MemoryLedger* ledger) {
   checkResolution("hydrogen", resolution);
-  // Maximum of r^4 exp(-2r/3) is at r = 6; (3 cos^2 - 1)^2 peaks at 4 on the z axis.
-  const float peak = 4.f * 1296.f * std::exp(-4.f);
+  const GridSpec grid = sceneGrid(resolution);
+  const float w = edgeHalfWidth(grid);
   BuiltinScene scene;
-  scene.volume = generateVolume("hydrogen", sceneGrid(resolution), precision, ledger, 0.0, 1.0,
-                                [=](glm::vec3 p) {
-                                  const glm::vec3 q = p * kBohrPerUnit;
-                                  const float r2 = glm::dot(q, q);
-                                  const float r = std::sqrt(r2);
-                                  const float angular = 3.f * q.z * q.z - r2;  // r^2 (3cos^2-1)
-                                  return angular * angular * std::exp(-2.f * r / 3.f) / peak;
-                                });
+  scene.volume = generateVolume("hydrogen", grid, precision, ledger, 0.0, 1.0, [](glm::vec3 p) {
+    return static_cast<float>(orbitalDensity(glm::dvec3(p)));
+  });
+  // Importance: the two lobes along z, as the soft region where the analytic density exceeds
+  // kLobeLevel (the torus never does), each wrapped in its own semi-opaque low-density envelope.
+  scene.importance = generateImportance(grid, precision, ledger, [=](glm::vec3 p) {
+    return softAbove(orbitalDensity, p, kLobeLevel, w);
+  });
   TransferFunction& tf = scene.transferFunction;
   tf.name = "hydrogen";
   tf.unitDistance = 2.f;

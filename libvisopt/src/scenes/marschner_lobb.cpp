@@ -1,5 +1,6 @@
 // The Marschner–Lobb scene: a reconstruction-filter benchmark; its transfer function shows the
-// rho = 0.5 level as a semi-opaque layer over the high values, which the importance marks.
+// rho = 0.5 level as a semi-opaque layer over the high values, whose inner, rippled part (within
+// a central sphere) the importance marks.
 #include "scenes/marschner_lobb.h"
 
 #include <cmath>
@@ -8,6 +9,11 @@
 #include "scenes/scene_makers.h"
 
 namespace visopt::scenes {
+
+namespace {
+constexpr double kImportantLevel = 0.75;
+constexpr float kImportantRadius = 0.6f;
+}  // namespace
 
 double marschnerLobb(glm::dvec3 p) {
   constexpr double pi = 3.14159265358979323846;
@@ -19,10 +25,20 @@ double marschnerLobb(glm::dvec3 p) {
 
 BuiltinScene makeMarschnerLobb(int resolution, Precision precision, MemoryLedger* ledger) {
   checkResolution("marschner-lobb", resolution);
+  const GridSpec grid = sceneGrid(resolution);
+  const float w = edgeHalfWidth(grid);
   BuiltinScene scene;
   scene.volume =
-      generateVolume("marschner-lobb", sceneGrid(resolution), precision, ledger, 0.0, 1.0,
+      generateVolume("marschner-lobb", grid, precision, ledger, 0.0, 1.0,
                      [](glm::vec3 p) { return static_cast<float>(marschnerLobb(glm::dvec3(p))); });
+  // Importance: the inner high-value lobes, {rho > kImportantLevel} within the central sphere
+  // |p| < kImportantRadius: the rippled lower lobes under the rho = 0.5 sheet. The sphere keeps
+  // them away from the volume's sides, so every view from above sees them through the sheet.
+  scene.importance = generateImportance(grid, precision, ledger, [=](glm::vec3 p) {
+    const float sphere = softInside(glm::length(p) - kImportantRadius, w);
+    if (sphere <= 0.f) return 0.f;
+    return sphere * softAbove(marschnerLobb, p, kImportantLevel, w);
+  });
   TransferFunction& tf = scene.transferFunction;
   tf.name = "marschner-lobb";
   tf.unitDistance = 2.f;

@@ -46,40 +46,67 @@ struct Ring {
   float radius, z, core, strength;
 };
 
+// The vortex tubes: a double helix trailing from the paddle tips and two ring vortices, each a
+// centre line with a Gaussian core.
+struct VortexTubes {
+  std::array<Ring, 2> rings = {Ring{0.68f, -0.68f, 0.07f, 0.8f}, Ring{0.35f, 0.45f, 0.06f, 0.7f}};
+  // Double helix: radius, pitch, core radius, strength, z range (faded out at both ends).
+  float helixR = 0.45f, pitch = 0.5f, helixCore = 0.06f, helixStrength = 0.95f;
+  float helixLo = -0.5f, helixHi = 0.35f;
+  float cosLead = std::cos(std::atan(pitch / (2.f * kPi * helixR)));
+
+  // Calls f(squared distance to the centre line, core radius, peak strength, fade) per tube; the
+  // vorticity is strength * fade * exp(-d^2 / core^2), fade in [0, 1] ending the helix.
+  template <class F>
+  void visit(glm::vec3 p, float rho, F f) const {
+    const float theta = std::atan2(p.y, p.x);
+    const float fade = softInside(maxOf(helixLo - p.z, p.z - helixHi), 0.08f);
+    for (int arm = 0; arm < 2; ++arm) {
+      float dz = p.z - helixLo - pitch * (theta / (2.f * kPi) + 0.5f * float(arm));
+      dz -= pitch * std::round(dz / pitch);
+      f((rho - helixR) * (rho - helixR) + dz * cosLead * dz * cosLead, helixCore, helixStrength,
+        fade);
+    }
+    for (const Ring& ring : rings)
+      f((rho - ring.radius) * (rho - ring.radius) + (p.z - ring.z) * (p.z - ring.z), ring.core,
+        ring.strength, 1.f);
+  }
+};
+
+// Inside the tank up to the free surface, soft edge w.
+float fluidInside(glm::vec3 p, float rho, float w) {
+  return softInside(maxOf(rho - kTankInner, maxOf(p.z - kFluidTop, kTankBottom + kWall - p.z)), w);
+}
+
 }  // namespace
 
 BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger) {
   checkResolution("mixer", resolution);
   const GridSpec grid = sceneGrid(resolution);
   const float w = edgeHalfWidth(grid);
-  const std::array<Ring, 2> rings = {Ring{0.68f, -0.68f, 0.07f, 0.8f},
-                                     Ring{0.35f, 0.45f, 0.06f, 0.7f}};
-  // Double helix: radius, pitch, core radius, strength, z range.
-  const float helixR = 0.45f, pitch = 0.5f, helixCore = 0.06f, helixStrength = 0.95f;
-  const float helixLo = -0.5f, helixHi = 0.35f;
-  const float cosLead = std::cos(std::atan(pitch / (2.f * kPi * helixR)));
+  const VortexTubes tubes;
 
   BuiltinScene scene;
   scene.volume = generateVolume("mixer", grid, precision, ledger, -1.0, 1.0, [=](glm::vec3 p) {
     const float rho = std::sqrt(p.x * p.x + p.y * p.y);
     // Quiet fluid with a little swirl, inside the tank up to the free surface.
     float vort = 0.05f + 0.03f * std::sin(6.f * p.z + 3.f * rho);
-    const float theta = std::atan2(p.y, p.x);
-    for (int arm = 0; arm < 2; ++arm) {
-      float dz = p.z - helixLo - pitch * (theta / (2.f * kPi) + 0.5f * float(arm));
-      dz -= pitch * std::round(dz / pitch);
-      const float d2 = (rho - helixR) * (rho - helixR) + dz * cosLead * dz * cosLead;
-      const float fade = softInside(maxOf(helixLo - p.z, p.z - helixHi), 0.08f);
-      vort = maxOf(vort, helixStrength * fade * std::exp(-d2 / (helixCore * helixCore)));
-    }
-    for (const Ring& ring : rings) {
-      const float d2 = (rho - ring.radius) * (rho - ring.radius) + (p.z - ring.z) * (p.z - ring.z);
-      vort = maxOf(vort, ring.strength * std::exp(-d2 / (ring.core * ring.core)));
-    }
-    const float fluid =
-        softInside(maxOf(rho - kTankInner, maxOf(p.z - kFluidTop, kTankBottom + kWall - p.z)), w);
-    const float v = fluid * vort;
+    tubes.visit(p, rho, [&](float d2, float core, float strength, float fade) {
+      vort = maxOf(vort, strength * fade * std::exp(-d2 / (core * core)));
+    });
+    const float v = fluidInside(p, rho, w) * vort;
     return v + (kSolidValue - v) * softInside(solidDistance(p, rho), w);
+  });
+  // Importance: the vortex tubes, each the soft solid cylinder (torus) of its core radius around
+  // its centre line (where the vorticity is above about a third of its peak), ending where
+  // the helix fades, and only in the fluid, not where a solid cuts them.
+  scene.importance = generateImportance(grid, precision, ledger, [=](glm::vec3 p) {
+    const float rho = std::sqrt(p.x * p.x + p.y * p.y);
+    float g = 0.f;
+    tubes.visit(p, rho, [&](float d2, float core, float /*strength*/, float fade) {
+      g = maxOf(g, fade * softInside(std::sqrt(d2) - core, w));
+    });
+    return g * fluidInside(p, rho, w) * (1.f - softInside(solidDistance(p, rho), w));
   });
 
   TransferFunction& tf = scene.transferFunction;

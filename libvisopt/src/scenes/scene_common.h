@@ -3,6 +3,7 @@
 // function at every voxel centre and stores it normalised, and smooth (anti-aliased) shapes.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -49,6 +50,22 @@ inline float softInside(float d, float w) {
   return 1.f - smoothStep(-w, w, d);
 }
 
+// Samples f(p) (p in normalised coordinates) at every voxel centre of `field`, in parallel, and
+// stores offset + scale * f(p) clamped to [0, 1].
+template <class F>
+void sampleIntoField(Field3D& field, float offset, float scale, F f) {
+  const FieldView view(field);
+  const GridSpec g = field.grid();
+  const int64_t nx = g.dims.x, ny = g.dims.y;
+  exec::parallelFor("scene-generate", static_cast<int64_t>(g.voxelCount()), [=](int64_t idx) {
+    const int64_t i = idx % nx, j = (idx / nx) % ny, k = idx / (nx * ny);
+    const glm::vec3 world = g.indexToWorld(
+        glm::vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)));
+    view.store(static_cast<size_t>(idx),
+               glm::clamp(offset + scale * f(world / kSceneHalf), 0.f, 1.f));
+  });
+}
+
 // Samples value(p) (p in normalised coordinates, value in data units) at every voxel centre and
 // stores (value - valueMin) / (valueMax - valueMin), clamped to [0, 1], in Field3D "volume".
 template <class F>
@@ -61,19 +78,34 @@ Volume generateVolume(const std::string& name, const GridSpec& grid, Precision p
   vol.valueMin = valueMin;
   vol.valueMax = valueMax;
   vol.normalized = Field3D("volume", grid, precision, ledger);
-  const FieldView view(vol.normalized);
-  const GridSpec g = grid;
-  const float lo = static_cast<float>(valueMin);
   const float invSpan = static_cast<float>(1.0 / (valueMax - valueMin));
-  const int64_t nx = grid.dims.x, ny = grid.dims.y;
-  exec::parallelFor("scene-generate", static_cast<int64_t>(grid.voxelCount()), [=](int64_t idx) {
-    const int64_t i = idx % nx, j = (idx / nx) % ny, k = idx / (nx * ny);
-    const glm::vec3 world = g.indexToWorld(
-        glm::vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k)));
-    const float v = value(world / kSceneHalf);
-    view.store(static_cast<size_t>(idx), glm::clamp((v - lo) * invSpan, 0.f, 1.f));
-  });
+  sampleIntoField(vol.normalized, -static_cast<float>(valueMin) * invSpan, invSpan, value);
   return vol;
+}
+
+// The scene's importance g(p) in [0, 1] (clamped), sampled like the volume on the same grid and
+// at the same precision, in Field3D "importance".
+template <class F>
+Field3D generateImportance(const GridSpec& grid, Precision precision, MemoryLedger* ledger,
+                           F importance) {
+  Field3D field("importance", grid, precision, ledger);
+  sampleIntoField(field, 0.f, 1.f, importance);
+  return field;
+}
+
+// Soft indicator of {f > level} for a smooth analytic f (normalised coordinates), from the
+// first-order signed distance (level - f) / |grad f| with a central-difference gradient, so the
+// edge is about 2w wide wherever the level set is regular.
+template <class F>
+float softAbove(F f, glm::vec3 p, double level, float w) {
+  const glm::dvec3 q(p);
+  constexpr double h = 1e-4;
+  const double fx = f(q + glm::dvec3(h, 0, 0)) - f(q - glm::dvec3(h, 0, 0));
+  const double fy = f(q + glm::dvec3(0, h, 0)) - f(q - glm::dvec3(0, h, 0));
+  const double fz = f(q + glm::dvec3(0, 0, h)) - f(q - glm::dvec3(0, 0, h));
+  const double grad = std::sqrt(fx * fx + fy * fy + fz * fz) / (2.0 * h);
+  const double d = (level - f(q)) / std::max(grad, 1e-9);
+  return softInside(static_cast<float>(glm::clamp(d, -1e3, 1e3)), w);
 }
 
 }  // namespace visopt::scenes

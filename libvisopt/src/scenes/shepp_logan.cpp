@@ -11,7 +11,10 @@ namespace visopt::scenes {
 
 namespace {
 constexpr size_t kEllipsoids = 10;
-}
+// Table rows 4..9 are the tumours (density +0.1 on the brain's 0.2: 0.3 in all).
+constexpr size_t kFirstTumour = 4;
+constexpr size_t kTumours = kEllipsoids - kFirstTumour;
+}  // namespace
 
 const std::vector<PhantomEllipsoid>& sheppLoganEllipsoids() {
   // centre, semi-axes, rotation about z (degrees), density
@@ -58,16 +61,39 @@ BuiltinScene makeSheppLogan(int resolution, Precision precision, MemoryLedger* l
     return sum;
   });
 
+  // Importance: the union of the tumour ellipsoids, from their geometry rather than their value,
+  // so the shell's edges (which pass through 0.3) stay at exactly 0. A tumour thinner than two
+  // voxels is dilated until the voxels around its centre reach 1 (the small ones at low
+  // resolutions). The tumours lie at least 0.2 inside the brain; to keep even a dilated edge off
+  // the shell, g is also cut to exactly 0 within two voxels of the brain's surface.
+  std::array<SoftEllipsoid, kTumours> tumours;
+  std::array<float, kTumours> dilation{};
+  for (size_t n = 0; n < kTumours; ++n) {
+    const glm::vec3 axes = table[kFirstTumour + n].semiAxes;
+    tumours[n] = shapes[kFirstTumour + n];
+    dilation[n] = glm::max(0.f, 2.f * w - glm::min(axes.x, glm::min(axes.y, axes.z)));
+  }
+  const SoftEllipsoid brain = shapes[1];
+  scene.importance = generateImportance(grid, precision, ledger, [=](glm::vec3 p) {
+    const float inBrain = softInside(brain.distance(p) + 3.f * w, w);
+    if (inBrain <= 0.f) return 0.f;
+    float g = 0.f;
+    for (size_t n = 0; n < kTumours; ++n)
+      g = glm::max(g, softInside(tumours[n].distance(p) - dilation[n], w));
+    return g * inBrain;
+  });
+
   TransferFunction& tf = scene.transferFunction;
   tf.name = "shepp-logan";
   tf.unitDistance = 2.f;  // mm
-  // Ventricles and air clear, brain a faint haze, tumours (0.3) red, the shell nearly opaque.
-  tf.opacity = {{0.0, 0.f},    {0.1, 0.f},    {0.2, 0.005f}, {0.25, 0.005f},
-                {0.28, 0.35f}, {0.32, 0.35f}, {0.36, 0.f},   {0.45, 0.f},
-                {0.6, 0.85f},  {0.8, 0.95f},  {1.0, 0.97f}};
+  // Ventricles and air clear, brain a faint haze, tumours (0.3) red, the shell nearly opaque
+  // from 0.42 up: the shell is only about 3 mm thick, so at coarse resolutions its smoothed
+  // profile peaks well below 1, and it must still hide the tumours.
+  tf.opacity = {{0.0, 0.f},    {0.1, 0.f},  {0.2, 0.005f}, {0.25, 0.005f}, {0.28, 0.35f},
+                {0.32, 0.35f}, {0.36, 0.f}, {0.42, 0.9f},  {0.8, 0.95f},   {1.0, 0.97f}};
   tf.color = {{0.0, {0.50f, 0.50f, 0.55f}},  {0.2, {0.75f, 0.70f, 0.70f}},
               {0.25, {0.75f, 0.70f, 0.70f}}, {0.28, {0.95f, 0.30f, 0.20f}},
-              {0.32, {0.95f, 0.30f, 0.20f}}, {0.45, {0.93f, 0.70f, 0.58f}},
+              {0.32, {0.95f, 0.30f, 0.20f}}, {0.38, {0.93f, 0.70f, 0.58f}},
               {1.0, {0.98f, 0.85f, 0.75f}}};
   tf.validate("scene shepp-logan");
   scene.azimuthDeg = 25.f;

@@ -1,0 +1,196 @@
+// visopt optimize: the extinction optimisation of paper 000 §II-C on a volume or built-in scene,
+// with per-iteration statistics, before/after images and an optional second viewpoint for the
+// frozen result.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+
+#include "cli_common.h"
+#include "commands.h"
+#include "visopt/error.h"
+
+namespace visopt::cli {
+
+namespace {
+
+std::atomic<bool> interrupted{false};
+void onInterrupt(int) { interrupted = true; }
+
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+nlohmann::json statsJson(const IterationStats& s) {
+  return {{"level", s.level},
+          {"iteration", s.iteration},
+          {"energy", s.energy()},
+          {"energy_rho", s.energyRho},
+          {"energy_q", s.energyQ},
+          {"energy_r", s.energyR},
+          {"visibility_view", s.visibilityView},
+          {"visibility_light", s.visibilityLight},
+          {"step_norm", s.stepNorm},
+          {"grid_updates_ms", s.gridUpdatesMs},
+          {"extinction_step_ms", s.extinctionStepMs}};
+}
+
+std::string beforePath(const std::string& out) {
+  std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + "-before" + p.extension().string())).string();
+}
+
+}  // namespace
+
+Runner addOptimizeCommand(CLI::App& app) {
+  struct Options {
+    std::string volume, scene, tf, importance, camera, light, viewFrom, size = "512x512",
+        precision = "fp32", optimizer = "ademamix", out;
+    int resolution = 128, levels = 3, iterations = 60;
+    float rho = -1.f, q = 40.f, r = 0.f, lr = 0.05f, muMax = 0.f, frustumScale = 0.5f,
+          tolerance = 1e-4f;
+    bool json = false, quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  app.add_option("--volume", o->volume, "Volume file or DICOM folder");
+  app.add_option("--scene", o->scene, "Built-in scene, builtin:NAME (carries its own importance)");
+  app.add_option("--resolution", o->resolution, "Built-in scene resolution (longest axis, voxels)");
+  app.add_option("--tf", o->tf, "Transfer function: JSON file (visopt or ParaView) or preset:NAME");
+  app.add_option("--importance", o->importance,
+                 "Importance g in [0,1]: a curve JSON {\"points\":[[value,g],...]} or a volume "
+                 "file on the same grid");
+  app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST (degrees, degrees, bounding radii)");
+  app.add_option("--light", o->light, "Point light on an orbit AZ,EL,DIST (default: key light)");
+  app.add_option("--rho", o->rho, "Weight of staying close to the transfer function (<0: 1/mu_max)");
+  app.add_option("--q", o->q, "Weight of seeing the important parts from the camera");
+  app.add_option("--r", o->r, "Weight of lighting the important parts (0: no light grids)");
+  app.add_option("--optimizer", o->optimizer, "ademamix (default) or adam");
+  app.add_option("--lr", o->lr, "Learning rate in units of mu_max per step");
+  app.add_option("--mu-max", o->muMax, "Upper bound of the extinction (0: the transfer function's)");
+  app.add_option("--levels", o->levels, "Coarse-to-fine multigrid levels");
+  app.add_option("--iterations", o->iterations, "Iteration cap per level");
+  app.add_option("--tolerance", o->tolerance, "Relative energy change that ends a level");
+  app.add_option("--frustum-scale", o->frustumScale, "Frustum rays per image pixel (per side)");
+  app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
+  app.add_option("--size", o->size, "Image size WxH (the frustum grids follow it)");
+  app.add_option("--out", o->out, "Render the optimised view here (and the unoptimised one "
+                                  "next to it as NAME-before.png)");
+  app.add_option("--view-from", o->viewFrom,
+                 "Also render the frozen result from this orbit AZ,EL,DIST (NAME-view.png)");
+  app.add_flag("--json", o->json, "Print per-iteration statistics, stage times and memory as JSON");
+  app.add_flag("--quiet", o->quiet, "No progress lines on stderr");
+
+  return [o]() {
+    resetStageTimings();
+    const auto t0 = std::chrono::steady_clock::now();
+    Engine engine(parsePrecision(o->precision));
+    ExtinctionSettings s;
+    s.rho = o->rho;
+    s.q = o->q;
+    s.r = o->r;
+    s.optimizer = parseOptimizerKind(o->optimizer);
+    s.learningRate = o->lr;
+    s.muMax = o->muMax;
+    s.levels = o->levels;
+    s.maxIterationsPerLevel = o->iterations;
+    s.tolerance = o->tolerance;
+    s.frustumScale = o->frustumScale;
+    const glm::ivec2 size = parseSize(o->size);
+    loadInput(engine, o->volume, o->scene, o->resolution, !o->json && !o->quiet);
+    if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
+    if (!o->importance.empty()) engine.loadImportance(o->importance);
+    if (!engine.hasImportance())
+      throw Error(ErrorKind::Usage, "--importance is needed for a volume file (scenes carry one)");
+    const Bounds bounds = engine.volume().grid().worldBounds();
+    if (!o->camera.empty()) {
+      glm::vec3 c = parseTriple(o->camera, "--camera");
+      if (!(c.z > 0.f)) throw Error(ErrorKind::Usage, "--camera: distance must be positive");
+      engine.orbitCamera(c.x, c.y, c.z);
+      engine.setLight(PointLight::keyLightFor(engine.camera(), bounds));
+    }
+    if (!o->light.empty()) {
+      glm::vec3 l = parseTriple(o->light, "--light");
+      PointLight light = engine.light();
+      light.position = Camera::orbitBounds(bounds, l.x, l.y, l.z).eye;
+      engine.setLight(light);
+    }
+    engine.setExtinctionSettings(s);
+    engine.setViewportSize(size.x, size.y);
+    const double setupMs = msSince(t0);
+
+    RenderSettings rs;
+    rs.width = size.x;
+    rs.height = size.y;
+    nlohmann::json images = nlohmann::json::object();
+    if (!o->out.empty()) {
+      writePng(engine.render(rs), beforePath(o->out));
+      images["before"] = beforePath(o->out);
+    }
+
+    interrupted = false;
+    auto previous = std::signal(SIGINT, onInterrupt);
+    const auto tOpt = std::chrono::steady_clock::now();
+    auto stats = engine.optimize([&](const IterationStats& st) {
+      if (!o->json && !o->quiet)
+        std::fprintf(stderr,
+                     "level %d  iteration %3d  energy %+.5e  V_view %.3f  V_light %.3f  step %.2e\n",
+                     st.level, st.iteration, st.energy(), st.visibilityView, st.visibilityLight,
+                     st.stepNorm);
+      return !interrupted.load();
+    });
+    const double optimizeMs = msSince(tOpt);
+    std::signal(SIGINT, previous);
+
+    double renderMs = 0.0;
+    if (!o->out.empty()) {
+      const auto tr = std::chrono::steady_clock::now();
+      writePng(engine.render(rs), o->out);
+      renderMs = msSince(tr);
+      images["after"] = o->out;
+      if (!o->viewFrom.empty()) {
+        glm::vec3 v = parseTriple(o->viewFrom, "--view-from");
+        engine.setFrozen(true);
+        engine.orbitCamera(v.x, v.y, v.z);
+        std::filesystem::path p(o->out);
+        const std::string viewPath =
+            (p.parent_path() / (p.stem().string() + "-view" + p.extension().string())).string();
+        writePng(engine.render(rs), viewPath);
+        images["view_from"] = viewPath;
+      }
+    }
+
+    if (o->json) {
+      nlohmann::json iterations = nlohmann::json::array();
+      for (const auto& st : stats) iterations.push_back(statsJson(st));
+      nlohmann::json j = {
+          {"command", "optimize"},
+          {"backend", backendDescription()},
+          {"input", engine.volume().sourcePath},
+          {"precision", o->precision},
+          {"settings",
+           {{"rho", s.rho}, {"q", s.q}, {"r", s.r}, {"optimizer", toString(s.optimizer)},
+            {"learning_rate", s.learningRate}, {"levels", s.levels},
+            {"iterations_per_level", s.maxIterationsPerLevel}, {"tolerance", s.tolerance},
+            {"frustum_scale", s.frustumScale}}},
+          {"interrupted", interrupted.load()},
+          {"iterations", iterations},
+          {"final", stats.empty() ? nlohmann::json() : statsJson(stats.back())},
+          {"initial", stats.empty() ? nlohmann::json() : statsJson(stats.front())},
+          {"times_ms", {{"setup", setupMs}, {"optimize", optimizeMs}, {"render", renderMs},
+                        {"total", msSince(t0)}}},
+          {"stages", stageTimingsJson()},
+          {"images", images},
+          {"memory", ledgerJson(engine.ledger())}};
+      std::printf("%s\n", j.dump(2).c_str());
+    } else if (!stats.empty()) {
+      const auto& f = stats.back();
+      std::printf("optimised in %.0f ms: energy %+.5e, visibility %.3f -> %.3f%s\n", optimizeMs,
+                  f.energy(), stats.front().visibilityView, f.visibilityView,
+                  o->out.empty() ? "" : (", wrote " + o->out).c_str());
+    }
+    return interrupted.load() ? kFailure : kOk;
+  };
+}
+
+}  // namespace visopt::cli

@@ -3,6 +3,7 @@
 // centres at integers and clamps to the border.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -34,9 +35,10 @@ struct FieldView {
   VISOPT_HD VISOPT_INLINE float load(size_t i) const {
     return half ? halfToFloat(static_cast<const Half*>(data)[i]) : static_cast<const float*>(data)[i];
   }
+  // fp16 stores saturate at +-65504 (fp16's largest finite value) rather than overflow to inf.
   VISOPT_HD void store(size_t i, float v) const {
     if (half)
-      static_cast<Half*>(data)[i] = floatToHalf(v);
+      static_cast<Half*>(data)[i] = floatToHalf(fminf(fmaxf(v, -65504.f), 65504.f));
     else
       static_cast<float*>(data)[i] = v;
   }

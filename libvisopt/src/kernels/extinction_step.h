@@ -70,10 +70,14 @@ struct ExtinctionStep {
   OptimizerCoefficients coefficients;
   float muMax = 1.f;
   float voxelVolume = 1.f;
+  // Gradients enter the optimiser multiplied by this per-level constant (1 / their RMS at the
+  // level's first step), so typical ones are ~1 and fp16 moments keep their precision. Adam-type
+  // updates are invariant to a constant gradient scale up to epsilon.
+  float gradientScale = 1.f;
 
   VISOPT_HD StepSums operator()(int64_t v) const {
     float mbar;
-    const float g = gradient.at(v, mbar);
+    const float g = gradientScale * gradient.at(v, mbar);
     const float m = gradient.mu.load(size_t(v));
     const float next = fminf(fmaxf(m + state.step(size_t(v), g, coefficients), 0.f), muMax);
     gradient.mu.store(size_t(v), next);

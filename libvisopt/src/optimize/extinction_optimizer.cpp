@@ -124,6 +124,7 @@ struct ExtinctionOptimizer::Level {
   FrustumGrid view, light;
   int shrink = 1;  // frustum grids are this many times coarser than at the finest level
   int t = 0;  // optimiser steps taken on this level
+  float gradientScale = 1.f;
   double lastEnergy = 0.0;
 };
 
@@ -150,9 +151,12 @@ GridSpec levelGrid(const GridSpec& fine, int factor) {
   return g;
 }
 
-float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s) {
+float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s, Precision p) {
   float m = s.muMax > 0.f ? s.muMax : in.transferMaxExtinction;
-  return m > 0.f ? m : 1.f;
+  if (!(m > 0.f)) m = 1.f;
+  // fp16 storage cannot hold more than 65504; beyond ~1e4 per world unit every voxel is opaque
+  // anyway, so the bound is lowered rather than letting stores saturate.
+  return p == Precision::FP16 ? std::min(m, 1e4f) : m;
 }
 
 }  // namespace
@@ -227,7 +231,7 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   const int shrink = L.shrink;
   (void)levels;
   const Bounds bounds = in.volume->grid().worldBounds();
-  const float muMax = levelMuMax(in, s);
+  const float muMax = levelMuMax(in, s, precision_);
 
   // Frustum grids for this level and the current camera and light.
   const int w = std::max(4, int(float(in.imageWidth) * s.frustumScale) / shrink);
@@ -313,6 +317,20 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   step.coefficients = c;
   step.muMax = muMax;
   step.voxelVolume = voxelVolume(L.grid);
+  if (t == 1) {
+    const ExtinctionGradient grad = step.gradient;
+    const double sum2 = exec::reduce(
+        "extinction step: gradient scale", int64_t(L.grid.voxelCount()), 0.0,
+        [=] VISOPT_HD(int64_t v) {
+          float mbar;
+          const double g = grad.at(v, mbar);
+          return g * g;
+        },
+        [] VISOPT_HD(double a, double b) { return a + b; });
+    const double rms = std::sqrt(sum2 / double(L.grid.voxelCount()));
+    L.gradientScale = rms > 1e-30 && std::isfinite(rms) ? float(1.0 / rms) : 1.f;
+  }
+  step.gradientScale = L.gradientScale;
   StepSums sums = exec::reduce("extinction step", int64_t(L.grid.voxelCount()), StepSums{}, step,
                                [] VISOPT_HD(const StepSums& a, const StepSums& b) { return a + b; });
   st.extinctionStepMs = msSince(t1);

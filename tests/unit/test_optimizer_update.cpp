@@ -64,7 +64,8 @@ TEST(OptimizerUpdate, MatchesTheReferenceRulesInFp32) {
       const double g = std::sin(0.3 * t) * 0.7 + 0.2;
       const float ours = st.step(0, float(g), coefficients(t, ademamix));
       const double theirs = ref.step(g, t, 0.9, 0.999, 0.9999, 5.0, 0.01, 1e-8, ademamix);
-      ASSERT_NEAR(ours, theirs, 1e-4 * std::abs(theirs) + 1e-8)  // 1e-8 = 1e-6 lr << "t " << t;
+      // 1e-8 = 1e-6 lr: where m1 and alpha m2 nearly cancel, fp32 rounding dominates.
+      ASSERT_NEAR(ours, theirs, 1e-4 * std::abs(theirs) + 1e-8) << "t " << t;
     }
   }
 }

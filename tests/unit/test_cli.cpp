@@ -1,0 +1,120 @@
+// The visopt command-line tool as a script would use it: exit codes (0 ok, 1 usage, 2 bad input,
+// 3 other), one JSON object on stdout with --json, one-line errors naming the file.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+Result run(const std::string& args) {
+  const fs::path dir = fs::path(VISOPT_TEST_TMP) / "cli";
+  fs::create_directories(dir);
+  const std::string errFile = (dir / "stderr.txt").string();
+  const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
+  Result r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(errFile);
+  r.err.assign(std::istreambuf_iterator<char>(e), {});
+  return r;
+}
+
+std::string tmp(const std::string& name) {
+  return (fs::path(VISOPT_TEST_TMP) / "cli" / name).string();
+}
+
+// The last line of stderr (the CPU-backend notice may come first).
+std::string lastLine(const std::string& text) {
+  std::string t = text;
+  while (!t.empty() && t.back() == '\n') t.pop_back();
+  const auto pos = t.rfind('\n');
+  return pos == std::string::npos ? t : t.substr(pos + 1);
+}
+
+}  // namespace
+
+TEST(Cli, ScenesListsTheDefault) {
+  Result r = run("scenes --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  bool hasDefault = false;
+  for (const auto& s : j["scenes"]) hasDefault |= s["default"].get<bool>();
+  EXPECT_TRUE(hasDefault);
+  EXPECT_GE(j["scenes"].size(), 4u);
+}
+
+TEST(Cli, RenderWritesPngAndReportsStagesAndLedger) {
+  const std::string out = tmp("render.png");
+  fs::remove(out);
+  Result r = run("render --scene builtin:marschner-lobb --resolution 32 --size 48x40 --precision fp16 --out " + out + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);  // exactly one JSON object
+  EXPECT_EQ(j["image"]["width"], 48);
+  EXPECT_GT(j["samples"].get<double>(), 0.0);
+  bool hasRender = false;
+  for (const auto& s : j["stages"]) hasRender |= s["name"] == "render";
+  EXPECT_TRUE(hasRender);
+  bool volumeFp16 = false;
+  for (const auto& f : j["memory"]["fields"])
+    if (f["name"] == "volume") volumeFp16 = f["precision"] == "fp16" && f["bytes"] == 32 * 32 * 32 * 2;
+  EXPECT_TRUE(volumeFp16);
+  EXPECT_TRUE(fs::exists(out));
+}
+
+TEST(Cli, UsageErrorsExitOne) {
+  EXPECT_EQ(run("").code, 1);
+  EXPECT_EQ(run("render --out x.png").code, 1);  // neither --volume nor --scene
+  EXPECT_EQ(run("render --scene builtin:nope --out " + tmp("x.png")).code, 1);
+  EXPECT_EQ(run("render --scene builtin:shepp-logan --size 0x5 --out " + tmp("x.png")).code, 1);
+  EXPECT_EQ(run("render --scene builtin:shepp-logan --precision fp8 --out " + tmp("x.png")).code, 1);
+  EXPECT_EQ(run("optimize --scene builtin:shepp-logan --optimizer sgd").code, 1);
+}
+
+TEST(Cli, BadInputExitsTwoWithOneLineNamingTheFile) {
+  const std::string bad = tmp("truncated.raw");
+  {
+    std::ofstream(bad, std::ios::binary) << "abc";
+    std::ofstream(bad + ".json") << R"({"dims":[4,4,4],"type":"float32","spacing":[1,1,1]})";
+  }
+  Result r = run("info " + bad);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(lastLine(r.err).find("truncated.raw"), std::string::npos) << r.err;
+  r = run("render --volume " + tmp("missing.nii") + " --out " + tmp("x.png"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(lastLine(r.err).find("missing.nii"), std::string::npos);
+  const std::string tf = tmp("broken-tf.json");
+  std::ofstream(tf) << "{ not json";
+  r = run("render --scene builtin:shepp-logan --resolution 16 --tf " + tf + " --out " + tmp("x.png"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(lastLine(r.err).find("broken-tf.json"), std::string::npos);
+  EXPECT_FALSE(fs::exists(tmp("x.png"))) << "no output for a failed run";
+}
+
+TEST(Cli, OptimizeReportsFallingEnergyAndRisingVisibility) {
+  const std::string out = tmp("opt.png");
+  Result r = run("optimize --scene builtin:shepp-logan --resolution 48 --size 64x64 --levels 2 "
+                 "--iterations 30 --out " + out + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_GT(j["iterations"].size(), 10u);
+  EXPECT_LT(j["final"]["energy"].get<double>(), j["initial"]["energy"].get<double>());
+  EXPECT_GT(j["final"]["visibility_view"].get<double>(), j["initial"]["visibility_view"].get<double>());
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(tmp("opt-before.png")));
+}

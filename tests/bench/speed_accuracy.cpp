@@ -40,7 +40,7 @@ double processCpuSeconds() {
 
 struct Run {
   double seconds = 0.0, cpuShare = 0.0;
-  int iterations = 0;
+  std::vector<visopt::IterationStats> stats;
   visopt::Image image;
   std::vector<float> mu;
 };
@@ -65,7 +65,7 @@ Run optimizeAndRender(visopt::Engine& engine, const visopt::ExtinctionSettings& 
   Run run;
   const double cpu0 = processCpuSeconds();
   const auto t0 = Clock::now();
-  run.iterations = static_cast<int>(engine.optimize().size());
+  run.stats = engine.optimize();
   run.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   run.cpuShare = (processCpuSeconds() - cpu0) / (run.seconds * tbb::info::default_concurrency());
   run.image = engine.render(renderSettings(setup));
@@ -86,6 +86,26 @@ double relativeRms(const std::vector<float>& a, const std::vector<float>& ref) {
   return norm > 0 ? std::sqrt(diff / norm) : NAN;
 }
 
+// How converged a run's last level is: its iterations and the relative energy change of its
+// last iteration.
+std::string convergence(const Run& r) {
+  if (r.stats.empty()) return "no iterations";
+  const int last = r.stats.back().level;
+  int n = 0;
+  for (const auto& st : r.stats) n += st.level == last ? 1 : 0;
+  double rel = NAN;
+  if (n >= 2) {
+    const double e1 = r.stats.back().energy(), e0 = r.stats[r.stats.size() - 2].energy();
+    rel = std::abs(e1 - e0) / std::max(std::abs(e1), 1e-30);
+  }
+  char buf[160];
+  std::snprintf(buf, sizeof buf,
+                "%d iterations at the finest level, last relative energy change %.2g, step RMS "
+                "%.2g, visibility %.3f",
+                n, rel, r.stats.back().stepNorm, r.stats.back().visibilityView);
+  return buf;
+}
+
 int run(const Setup& setup) {
   const auto start = Clock::now();
   std::printf("# Speed/accuracy: %s %d³, %d² image, %s\n\n", setup.scene.c_str(), setup.volume,
@@ -98,17 +118,18 @@ int run(const Setup& setup) {
   visopt::ExtinctionSettings ref;
   ref.levels = 3;
   ref.frustumScale = 1.f;
-  ref.maxIterationsPerLevel = 400;
-  ref.tolerance = 1e-7f;
+  ref.maxIterationsPerLevel = 200;
+  ref.tolerance = 1e-6f;
   const Run refRun = optimizeAndRender(reference, ref, setup);
   reference.setRenderOptimized(false);
   const visopt::Image unoptimized = reference.render(renderSettings(setup));
   std::printf(
       "Reference: fp32, 3 levels, frustum scale 1, at most %d iterations per level, tolerance "
-      "%g: %d iterations in %.1f s (CPU share %.2f).\nThe unoptimised image (mu_bar) against "
-      "it: PSNR %.2f dB, SSIM %.4f.\n\n",
-      ref.maxIterationsPerLevel, static_cast<double>(ref.tolerance), refRun.iterations,
-      refRun.seconds, refRun.cpuShare, visopt::psnr(unoptimized, refRun.image),
+      "%g: %zu iterations in %.1f s (CPU share %.2f); %s.\nThe unoptimised image (mu_bar) "
+      "against it: PSNR %.2f dB, SSIM %.4f.\n\n",
+      ref.maxIterationsPerLevel, static_cast<double>(ref.tolerance), refRun.stats.size(),
+      refRun.seconds, refRun.cpuShare, convergence(refRun).c_str(),
+      visopt::psnr(unoptimized, refRun.image),
       visopt::bench::ssim(unoptimized, refRun.image));
   std::fflush(stdout);
 
@@ -129,7 +150,7 @@ int run(const Setup& setup) {
           const Run r = optimizeAndRender(engine, s, setup);
           std::printf("| %s | %d | %.2f | %d | %d | %.2f | %.2f | %.2f | %.4f | %.4f |\n",
                       visopt::toString(p), levels, static_cast<double>(scale), budget,
-                      r.iterations, r.seconds, r.cpuShare, visopt::psnr(r.image, refRun.image),
+                      static_cast<int>(r.stats.size()), r.seconds, r.cpuShare, visopt::psnr(r.image, refRun.image),
                       visopt::bench::ssim(r.image, refRun.image), relativeRms(r.mu, refRun.mu));
           std::fflush(stdout);
         }

@@ -51,7 +51,7 @@ StreamResult runStreamProbe(size_t arrayBytes, int repeats) {
   double* pc = c.get();
   forEachChunk(n, [=](size_t lo, size_t hi) {
     for (size_t i = lo; i < hi; ++i) {
-      pa[i] = 1.0;
+      pa[i] = 0.0;
       pb[i] = 2.0;
       pc[i] = 0.0;
     }
@@ -75,7 +75,7 @@ StreamResult runStreamProbe(size_t arrayBytes, int repeats) {
   for (int rep = 0; rep < std::max(repeats, 1); ++rep) {
     bestCopy = std::min(bestCopy, timed([&] {
       forEachChunk(n, [=](size_t lo, size_t hi) {
-        for (size_t i = lo; i < hi; ++i) pc[i] = pa[i];
+        for (size_t i = lo; i < hi; ++i) pc[i] = pb[i];
       });
     }));
     bestTriad = std::min(bestTriad, timed([&] {
@@ -84,9 +84,9 @@ StreamResult runStreamProbe(size_t arrayBytes, int repeats) {
       });
     }));
   }
-  // Checks that the kernels ran (and keeps the compiler from dropping them): after the first
-  // copy c = 1, every triad leaves a = 2 + 3 * 1 = 5.
-  if (pa[n / 2] != 5.0 || pc[n - 1] != 1.0) std::fprintf(stderr, "stream probe: wrong result\n");
+  // Checks that the kernels ran (and keeps the compiler from dropping them): every copy leaves
+  // c = b = 2 and every triad a = 2 + 3 * 2 = 8.
+  if (pa[n / 2] != 8.0 || pc[n - 1] != 2.0) std::fprintf(stderr, "stream probe: wrong result\n");
   const double bytes = static_cast<double>(n) * sizeof(double);
   result.copyGBs = 2.0 * bytes / bestCopy * 1e-9;
   result.triadGBs = 3.0 * bytes / bestTriad * 1e-9;

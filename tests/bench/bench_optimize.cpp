@@ -30,8 +30,9 @@
 //
 // After the benchmarks, Markdown tables of all cases (Table-I style, memory per field, bandwidth)
 // are printed to stdout. The STREAM probe runs before and after the benchmarks.
-// Environment: VISOPT_BENCH_STREAM_MIB sets the probe's array size (default: twice the
-// last-level cache, at least 256 MiB, at most 2 GiB per array).
+// Environment: VISOPT_BENCH_FULL=1 runs the larger set (see cases()); VISOPT_BENCH_STREAM_MIB sets
+// the probe's array size (default: twice the last-level cache, at least 256 MiB, at most 2 GiB per
+// array).
 #include <benchmark/benchmark.h>
 
 #include <tbb/info.h>
@@ -126,8 +127,8 @@ double fractionInBox(const visopt::FrustumGrid& f, const visopt::GridSpec& grid)
   for (int k = 0; k < f.dims.z; ++k)
     for (int j = 0; j < f.dims.y; ++j)
       for (int i = 0; i < f.dims.x; ++i, ++total) {
-        const glm::vec3 x = grid.worldToIndex(
-            f.toWorld(glm::vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k))));
+        const glm::vec3 x = grid.worldToIndex(f.toWorld(
+            glm::vec3(static_cast<float>(i), static_cast<float>(j), static_cast<float>(k))));
         if (glm::all(glm::greaterThanEqual(x, lo)) && glm::all(glm::lessThanEqual(x, hi))) ++inside;
       }
   return static_cast<double>(inside) / static_cast<double>(total);
@@ -256,7 +257,9 @@ void applyByteModel(LevelResult& r, const CaseResult& cr) {
                 std::min(cr.inBoxLight * lightBytes, 8 * v);
 }
 
-double gbs(double bytes, double ms) { return ms > 0 ? bytes / (ms * 1e-3) * 1e-9 : 0.0; }
+double gbs(double bytes, double ms) {
+  return ms > 0 ? bytes / (ms * 1e-3) * 1e-9 : 0.0;
+}
 
 void runCase(benchmark::State& state, const Case& c) {
   visopt::Engine engine(c.precision);
@@ -321,16 +324,24 @@ void runCase(benchmark::State& state, const Case& c) {
   results().push_back(std::move(cr));
 }
 
+// The default set runs in about 4 minutes on 2 shared cores; VISOPT_BENCH_FULL=1 adds the
+// 256^3 volume with the 512^2 frustum (each iteration ~2.5 GB of frustum field and seconds of
+// work), the light term at 256^3 and Shepp-Logan at 512^2 (about 12 minutes in all).
 std::vector<Case> cases() {
+  const char* env = std::getenv("VISOPT_BENCH_FULL");
+  const bool full = env && *env && std::string(env) != "0";
   std::vector<Case> out;
   const Precision precisions[] = {Precision::FP32, Precision::FP16};
   for (int volume : {64, 128, 256})
     for (int frustum : {256, 512})
-      for (Precision p : precisions) out.push_back({"earth-mantle", volume, frustum, p, false});
+      for (Precision p : precisions)
+        if (full || volume * frustum < 256 * 512)
+          out.push_back({"earth-mantle", volume, frustum, p, false});
+  // The light term adds the light grid (ExtinctionSettings::lightGridSize rays per side).
   for (int volume : {128, 256})
-    for (Precision p : precisions) out.push_back({"earth-mantle", volume, 512, p, true});
-  for (int volume : {128, 256})
-    for (Precision p : precisions) out.push_back({"shepp-logan", volume, 512, p, false});
+    for (Precision p : precisions)
+      if (full || volume == 128) out.push_back({"earth-mantle", volume, 256, p, true});
+  for (Precision p : precisions) out.push_back({"shepp-logan", 128, full ? 512 : 256, p, false});
   return out;
 }
 
@@ -353,7 +364,8 @@ void printSummary(const visopt::bench::StreamResult& before,
   std::printf("\n## Memory-bandwidth probe (STREAM-like, %d threads, %.0f MiB per array)\n\n",
               before.threads, static_cast<double>(before.arrayBytes) / kMiB);
   std::printf("| when | copy GB/s | triad GB/s | CPU share |\n|---|---|---|---|\n");
-  std::printf("| before | %.2f | %.2f | %.2f |\n", before.copyGBs, before.triadGBs, before.cpuShare);
+  std::printf("| before | %.2f | %.2f | %.2f |\n", before.copyGBs, before.triadGBs,
+              before.cpuShare);
   std::printf("| after | %.2f | %.2f | %.2f |\n", after.copyGBs, after.triadGBs, after.cpuShare);
   const double triad = std::max(before.triadGBs, after.triadGBs);
   std::printf("\nFractions below are of the better triad figure, %.2f GB/s.\n", triad);
@@ -362,21 +374,30 @@ void printSummary(const visopt::bench::StreamResult& before,
               visopt::backendDescription().c_str());
   std::printf(
       "| scene | volume | frustum | prec | r | level | voxels | view grid | light grid | grid "
-      "updates | (view / light) | extinction step | CPU share | iters |\n"
-      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "updates | (view / light) | extinction step | CPU share | CPU-ms / iteration | ns / view "
+      "cell / core | iters |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  const double threads = tbb::info::default_concurrency();
   for (const CaseResult& cr : results())
-    for (const LevelResult& r : cr.levels)
-      std::printf("| %s | %d³ | %d² | %s | %s | %d | %lld | %s | %s | %.2f | %.2f / %.2f | %.2f | "
-                  "%.2f | %d |\n",
-                  cr.c.scene.c_str(), cr.c.volume, cr.c.frustum, visopt::toString(cr.c.precision),
-                  cr.c.light ? ">0" : "0", r.level, static_cast<long long>(r.voxels),
-                  dims3(r.viewRays, r.viewCells).c_str(), dims3(r.lightRays, r.lightCells).c_str(),
-                  r.gridMs, r.viewMs, r.lightMs, r.stepMs, r.cpuShare, r.measured);
+    for (const LevelResult& r : cr.levels) {
+      // Wall time times the CPU share actually obtained: robust against other load.
+      const double cpuMs = (r.gridMs + r.stepMs) * r.cpuShare * threads;
+      const double nsPerCell =
+          r.viewCells > 0 ? r.viewMs * r.cpuShare * threads * 1e6 / double(r.viewCells) : 0.0;
+      std::printf(
+          "| %s | %d³ | %d² | %s | %s | %d | %lld | %s | %s | %.2f | %.2f / %.2f | %.2f | "
+          "%.2f | %.1f | %.1f | %d |\n",
+          cr.c.scene.c_str(), cr.c.volume, cr.c.frustum, visopt::toString(cr.c.precision),
+          cr.c.light ? ">0" : "0", r.level, static_cast<long long>(r.voxels),
+          dims3(r.viewRays, r.viewCells).c_str(), dims3(r.lightRays, r.lightCells).c_str(),
+          r.gridMs, r.viewMs, r.lightMs, r.stepMs, r.cpuShare, cpuMs, nsPerCell, r.measured);
+    }
 
   std::printf("\n## Memory per field at the finest level (MiB, engine ledger)\n\n");
   std::printf(
       "| scene | volume | frustum | prec | r | extinction | m1 | m2 | rms | view-derivative | "
-      "light-derivative | other | total |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+      "light-derivative | other | total "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   const char* named[] = {"extinction",    "optimizer-m1",    "optimizer-m2",
                          "optimizer-rms", "view-derivative", "light-derivative"};
   for (const CaseResult& cr : results()) {
@@ -397,7 +418,8 @@ void printSummary(const visopt::bench::StreamResult& before,
     for (const auto& e : results().back().levels.back().ledger) {
       bool isNamed = false;
       for (const char* n : named) isNamed = isNamed || e.name == n;
-      if (!isNamed) std::printf(" %s (%s, %s MiB);", e.name.c_str(), e.precision.c_str(), mib(e.bytes).c_str());
+      if (!isNamed)
+        std::printf(" %s (%s, %s MiB);", e.name.c_str(), e.precision.c_str(), mib(e.bytes).c_str());
     }
     std::printf("\n");
   }
@@ -412,15 +434,17 @@ void printSummary(const visopt::bench::StreamResult& before,
     for (const LevelResult& r : cr.levels) {
       const double g = gbs(r.gridBytes, r.gridMs), gc = gbs(r.gridBytesCoded, r.gridMs);
       const double st = gbs(r.stepBytes, r.stepMs);
-      std::printf("| %s | %d³ | %d² | %s | %s | %d | %.1f | %.2f | %.3f | %.3f | %.1f | %.2f | %.3f |\n",
-                  cr.c.scene.c_str(), cr.c.volume, cr.c.frustum, visopt::toString(cr.c.precision),
-                  cr.c.light ? ">0" : "0", r.level, r.gridBytes * 1e-6, g, g / triad, gc / triad,
-                  r.stepBytes * 1e-6, st, st / triad);
+      std::printf(
+          "| %s | %d³ | %d² | %s | %s | %d | %.1f | %.2f | %.3f | %.3f | %.1f | %.2f | %.3f |\n",
+          cr.c.scene.c_str(), cr.c.volume, cr.c.frustum, visopt::toString(cr.c.precision),
+          cr.c.light ? ">0" : "0", r.level, r.gridBytes * 1e-6, g, g / triad, gc / triad,
+          r.stepBytes * 1e-6, st, st / triad);
     }
-  std::printf("\nFrustum cells inside the volume's box (for the step's gather): view %.3f, light %.3f"
-              " (last case)\n",
-              results().empty() ? 0.0 : results().back().inBoxView,
-              results().empty() ? 0.0 : results().back().inBoxLight);
+  std::printf(
+      "\nFrustum cells inside the volume's box (for the step's gather): view %.3f, light %.3f"
+      " (last case)\n",
+      results().empty() ? 0.0 : results().back().inBoxView,
+      results().empty() ? 0.0 : results().back().inBoxLight);
 }
 
 size_t streamArrayBytes() {

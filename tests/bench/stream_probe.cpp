@@ -72,17 +72,19 @@ StreamResult runStreamProbe(size_t arrayBytes, int repeats) {
   };
   const double scalar = 3.0;
   double bestCopy = 1e30, bestTriad = 1e30;
+  auto copy = [=] {
+    forEachChunk(n, [=](size_t lo, size_t hi) {
+      for (size_t i = lo; i < hi; ++i) pc[i] = pb[i];
+    });
+  };
+  auto triad = [=] {
+    forEachChunk(n, [=](size_t lo, size_t hi) {
+      for (size_t i = lo; i < hi; ++i) pa[i] = pb[i] + scalar * pc[i];
+    });
+  };
   for (int rep = 0; rep < std::max(repeats, 1); ++rep) {
-    bestCopy = std::min(bestCopy, timed([&] {
-      forEachChunk(n, [=](size_t lo, size_t hi) {
-        for (size_t i = lo; i < hi; ++i) pc[i] = pb[i];
-      });
-    }));
-    bestTriad = std::min(bestTriad, timed([&] {
-      forEachChunk(n, [=](size_t lo, size_t hi) {
-        for (size_t i = lo; i < hi; ++i) pa[i] = pb[i] + scalar * pc[i];
-      });
-    }));
+    bestCopy = std::min(bestCopy, timed(copy));
+    bestTriad = std::min(bestTriad, timed(triad));
   }
   // Checks that the kernels ran (and keeps the compiler from dropping them): every copy leaves
   // c = b = 2 and every triad a = 2 + 3 * 2 = 8.

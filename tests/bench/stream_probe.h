@@ -8,11 +8,11 @@
 namespace visopt::bench {
 
 struct StreamResult {
-  size_t arrayBytes = 0;   // bytes of each of the three arrays
-  int threads = 0;         // oneTBB's default concurrency
-  double copyGBs = 0.0;    // best of the repeats, c[i] = b[i]: 16 bytes per element
-  double triadGBs = 0.0;   // best of the repeats, a[i] = b[i] + s * c[i]: 24 bytes per element
-  double cpuShare = 0.0;   // process CPU seconds / (wall seconds * threads) over the timed loops
+  size_t arrayBytes = 0;  // bytes of each of the three arrays
+  int threads = 0;        // oneTBB's default concurrency
+  double copyGBs = 0.0;   // best of the repeats, c[i] = b[i]: 16 bytes per element
+  double triadGBs = 0.0;  // best of the repeats, a[i] = b[i] + s * c[i]: 24 bytes per element
+  double cpuShare = 0.0;  // process CPU seconds / (wall seconds * threads) over the timed loops
 };
 
 // Runs copy and triad on three arrays of doubles of about `arrayBytes` each, `repeats` times

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -21,7 +23,10 @@ struct Result {
 Result run(const std::string& args) {
   const fs::path dir = fs::path(VISOPT_TEST_TMP) / "cli";
   fs::create_directories(dir);
-  const std::string errFile = (dir / "stderr.txt").string();
+  // ctest runs the tests of this file as parallel processes: one stderr file per call.
+  static int calls = 0;
+  const std::string errFile =
+      (dir / ("stderr-" + std::to_string(getpid()) + "-" + std::to_string(calls++) + ".txt")).string();
   const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
   Result r;
   FILE* pipe = popen(cmd.c_str(), "r");
@@ -100,10 +105,11 @@ TEST(Cli, BadInputExitsTwoWithOneLineNamingTheFile) {
   EXPECT_NE(lastLine(r.err).find("missing.nii"), std::string::npos);
   const std::string tf = tmp("broken-tf.json");
   std::ofstream(tf) << "{ not json";
-  r = run("render --scene builtin:shepp-logan --resolution 16 --tf " + tf + " --out " + tmp("x.png"));
+  const std::string never = tmp("never-written.png");
+  r = run("render --scene builtin:shepp-logan --resolution 16 --tf " + tf + " --out " + never);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(lastLine(r.err).find("broken-tf.json"), std::string::npos);
-  EXPECT_FALSE(fs::exists(tmp("x.png"))) << "no output for a failed run";
+  EXPECT_FALSE(fs::exists(never)) << "no output for a failed run";
 }
 
 TEST(Cli, OptimizeReportsFallingEnergyAndRisingVisibility) {

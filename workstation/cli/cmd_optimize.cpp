@@ -6,6 +6,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 
 #include "cli_common.h"
 #include "commands.h"
@@ -33,7 +34,14 @@ nlohmann::json statsJson(const IterationStats& s) {
           {"visibility_light", s.visibilityLight},
           {"step_norm", s.stepNorm},
           {"grid_updates_ms", s.gridUpdatesMs},
-          {"extinction_step_ms", s.extinctionStepMs}};
+          {"extinction_step_ms", s.extinctionStepMs},
+          {"sdf_step_ms", s.sdfStepMs},
+          {"redistance_ms", s.redistanceMs},
+          {"redistance_iterations", s.redistanceIterations},
+          {"redistance_residual", s.redistanceResidual},
+          {"level_set_time_step", s.levelSetTimeStep},
+          {"max_deviation_voxels", s.maxDeviationVoxels},
+          {"mean_deviation_voxels", s.meanDeviationVoxels}};
 }
 
 std::string beforePath(const std::string& out) {
@@ -46,7 +54,11 @@ std::string beforePath(const std::string& out) {
 Runner addOptimizeCommand(CLI::App& app) {
   struct Options {
     std::string volume, scene, tf, importance, camera, light, viewFrom, size = "512x512",
-        precision = "fp32", optimizer = "ademamix", out;
+        precision = "fp32", optimizer = "ademamix", out, worldMask, lens;
+    std::vector<std::string> contexts;
+    float shell = -1.f, lambda = -1.f;
+    int redistIterations = -1;
+    bool filled = false, deviationView = false;
     int resolution = 128, levels = 3, iterations = 60;
     float rho = -1.f, q = 40.f, r = 0.f, lr = 0.05f, muMax = 0.f, frustumScale = 0.5f,
           tolerance = 1e-4f;
@@ -72,6 +84,21 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--iterations", o->iterations, "Iteration cap per level");
   app.add_option("--tolerance", o->tolerance, "Relative energy change that ends a level");
   app.add_option("--frustum-scale", o->frustumScale, "Frustum rays per image pixel (per side)");
+  app.add_option("--context", o->contexts,
+                 "Context surface (repeatable): iso:VALUE[:inside-high|inside-low], mesh:FILE "
+                 "or vdb:FILE");
+  auto* shellOpt = app.add_option("--shell", o->shell,
+                                  "Context surfaces as thin shells reaching D (world units) to "
+                                  "either side of the surface (Eq. 26)");
+  app.add_flag("--filled", o->filled, "Context surfaces filled (the default)")->excludes(shellOpt);
+  app.add_option("--lambda", o->lambda, "How strongly surfaces return to their base shape (Eq. 23)");
+  app.add_option("--redist-iterations", o->redistIterations, "Redistancing iterations at most (Eq. 18)");
+  app.add_option("--world-mask", o->worldMask,
+                 "Volume file on the data grid: non-zero voxels keep their context surface");
+  app.add_option("--lens", o->lens,
+                 "Importance lens X,Y,R[,STRENGTH] in output-image pixels (strength multiplies g)");
+  app.add_flag("--deviation-view", o->deviationView,
+               "Colour surfaces by how far they moved from their base (|phi0| in voxels)");
   app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
   app.add_option("--size", o->size, "Image size WxH (the frustum grids follow it)");
   app.add_option("--out", o->out, "Render the optimised view here (and the unoptimised one "
@@ -97,9 +124,36 @@ Runner addOptimizeCommand(CLI::App& app) {
     s.tolerance = o->tolerance;
     s.frustumScale = o->frustumScale;
     const glm::ivec2 size = parseSize(o->size);
+    (void)o->filled;
     loadInput(engine, o->volume, o->scene, o->resolution, !o->json && !o->quiet);
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
     if (!o->importance.empty()) engine.loadImportance(o->importance);
+    LevelSetSettings ls = engine.levelSetSettings();
+    if (o->lambda >= 0.f) ls.lambda = o->lambda;
+    if (o->redistIterations >= 0) ls.redistanceIterations = o->redistIterations;
+    engine.setLevelSetSettings(ls);
+    for (const auto& c : o->contexts) {
+      ContextSurfaceSpec spec;
+      spec.source = c;
+      spec.filled = o->shell < 0.f;
+      spec.shell = std::max(o->shell, 0.f);
+      engine.addContextSurface(spec);
+    }
+    if (!o->worldMask.empty()) engine.loadWorldMask(o->worldMask);
+    if (!o->lens.empty()) {
+      std::vector<float> v;
+      std::stringstream ss(o->lens);
+      std::string part;
+      while (std::getline(ss, part, ',')) v.push_back(parseTriple(part + ",0,0", "--lens").x);
+      if (v.size() < 3 || v.size() > 4 || !(v[2] > 0.f))
+        throw Error(ErrorKind::Usage, "--lens: expected X,Y,R[,STRENGTH] with R > 0");
+      ImportanceLens lens;
+      lens.x = v[0] / float(size.x);
+      lens.y = v[1] / float(size.y);
+      lens.radius = v[2] / float(size.x);
+      if (v.size() == 4) lens.strength = v[3];
+      engine.setLens(lens);
+    }
     if (!engine.hasImportance())
       throw Error(ErrorKind::Usage, "--importance is needed for a volume file (scenes carry one)");
     const Bounds bounds = engine.volume().grid().worldBounds();
@@ -122,6 +176,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     RenderSettings rs;
     rs.width = size.x;
     rs.height = size.y;
+    rs.deviationView = o->deviationView;
     nlohmann::json images = nlohmann::json::object();
     if (!o->out.empty()) {
       writePng(engine.render(rs), beforePath(o->out));

@@ -14,5 +14,6 @@ Runner addInfoCommand(CLI::App& app);
 Runner addScenesCommand(CLI::App& app);
 Runner addRenderCommand(CLI::App& app);
 Runner addOptimizeCommand(CLI::App& app);
+Runner addSdfCommand(CLI::App& app);
 
 }  // namespace visopt::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   add(addScenesCommand, "scenes", "List the built-in scenes");
   add(addRenderCommand, "render", "Render a volume or built-in scene to a PNG");
   add(addOptimizeCommand, "optimize", "Optimise the extinction so the important parts show");
+  add(addSdfCommand, "sdf", "Convert a triangle mesh to a signed distance field (.vdb)");
 
   try {
     app.parse(argc, argv);

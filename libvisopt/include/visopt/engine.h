@@ -12,6 +12,7 @@
 #include "visopt/camera.h"
 #include "visopt/exec.h"
 #include "visopt/image.h"
+#include "visopt/level_set.h"
 #include "visopt/memory_ledger.h"
 #include "visopt/optimization.h"
 #include "visopt/precision.h"
@@ -22,6 +23,17 @@
 #include "visopt/volume.h"
 
 namespace visopt {
+
+// A context surface (paper 000 §III): opaque geometry held as an SDF on the volume's grid.
+struct ContextSurfaceSpec {
+  // "iso:VALUE[:inside-high|inside-low]" (an isosurface of the data; inside-high: values above
+  // VALUE are inside, the default), "mesh:FILE" (OBJ/PLY/OFF/STL) or "vdb:FILE".
+  std::string source;
+  bool filled = true;
+  float shell = 0.f;  // d of Eq. 26 in world units when !filled: the shell reaches d each side
+  glm::vec3 color{0.87f, 0.72f, 0.6f};
+  bool visible = true;
+};
 
 class Engine {
  public:
@@ -58,6 +70,36 @@ class Engine {
   void loadImportance(const std::string& path);
   bool hasImportance() const;
   const Field3D* importance() const;
+  // Where the importance came from, so a session can rebuild it.
+  struct ImportanceSource {
+    enum class Kind { None, Scene, Curve, Volume } kind = Kind::None;
+    std::vector<glm::dvec2> curve;  // Kind::Curve: (value, g) points in data units
+    std::string path;               // Kind::Volume: the file
+  };
+  const ImportanceSource& importanceSource() const;
+
+  // ---- context surfaces (paper 000 §III) ----
+  // Builds the base SDF phi0 on the volume grid; returns the surface's index. Errors: Usage for a
+  // malformed source, BadInput for unreadable files or meshes unfit for a filled SDF.
+  int addContextSurface(const ContextSurfaceSpec& spec, const ProgressCallback& progress = {});
+  void clearContextSurfaces();
+  const std::vector<ContextSurfaceSpec>& contextSurfaces() const;
+  void setContextSurfaceVisible(int index, bool visible);
+  // phi: the optimised SDF when there is one, else the base SDF; phi0: the base SDF.
+  const Field3D* contextSurfacePhi(int index) const;
+  const Field3D* contextSurfaceBase(int index) const;
+  void setLevelSetSettings(const LevelSetSettings& settings);
+  const LevelSetSettings& levelSetSettings() const;
+  // World-space mask (R5): where set, surfaces keep their base shape. A volume file on the data's
+  // grid (non-zero = masked), or a field given directly; clearWorldMask() removes it.
+  void loadWorldMask(const std::string& path);
+  void setWorldMask(Field3D mask);
+  void clearWorldMask();
+  const Field3D* worldMask() const;
+  void setLens(const ImportanceLens& lens);
+  const ImportanceLens& lens() const;
+  // ghat (Eq. 19) of the last optimisation iteration, when there are surfaces.
+  const Field3D* importanceBehind() const;
 
   // ---- extinction optimisation (paper 000 §II-C, Eqs. 10-14) ----
   void setExtinctionSettings(const ExtinctionSettings& settings);

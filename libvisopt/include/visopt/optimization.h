@@ -38,6 +38,14 @@ struct ExtinctionSettings {
   int lightGridSize = 128;  // light frustum rays per side at the finest level
 };
 
+// A circular importance lens (paper 000 §III-F, Fig. 8): inside it the importance along the view
+// rays is multiplied by `strength` (0 hides, > 1 boosts, clamped to g <= 1).
+struct ImportanceLens {
+  float x = 0.5f, y = 0.5f;  // centre in normalised image coordinates, y down
+  float radius = 0.f;        // fraction of the image width; 0: no lens
+  float strength = 2.f;
+};
+
 struct IterationStats {
   int level = 0, iteration = 0;
   double energyRho = 0.0, energyQ = 0.0, energyR = 0.0;
@@ -47,6 +55,14 @@ struct IterationStats {
   double stepNorm = 0.0;         // RMS of the change of mu over the voxels
   double gridUpdatesMs = 0.0;    // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
   double extinctionStepMs = 0.0; // gather, optimiser step, projection ("Ext. Opt.")
+  // Context surfaces (paper 000 Eqs. 18-23), when there are any.
+  double sdfStepMs = 0.0;         // ghat gather and the level-set step ("SDF Opt.")
+  double redistanceMs = 0.0;      // all redistancing iterations ("Redist." x iterations)
+  int redistanceIterations = 0;
+  double redistanceResidual = 0.0;  // mean squared change of the last iteration (voxels^2)
+  double levelSetTimeStep = 0.0;
+  double maxDeviationVoxels = 0.0;  // |phi0| on the current surface, over surface voxels
+  double meanDeviationVoxels = 0.0;
 };
 
 }  // namespace visopt

@@ -35,6 +35,16 @@ struct RenderSettings {
   int lightGridDepth = 0;
   // Stop marching once the view transmittance drops below this.
   float earlyStop = 1e-4f;
+
+  // Context surfaces (paper 000 Eq. 8 and §III-E): shaded with normalised Blinn-Phong, shadowed
+  // through T_L, darkened by ambient occlusion from the volume and the SDF.
+  float surfaceSpecular = 0.3f, surfaceShininess = 32.f;
+  bool ambientOcclusion = true;
+  float ambientOcclusionRadius = 6.f;  // in voxels
+  // Deviation view (Fig. 5): colour the surfaces by |phi0| at the hit, in voxels, through a
+  // colormap over [0, deviationMaxVoxels].
+  bool deviationView = false;
+  float deviationMaxVoxels = 10.f;
 };
 
 struct RenderStats {

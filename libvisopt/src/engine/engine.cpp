@@ -1,9 +1,11 @@
 #include "visopt/engine.h"
 
 #include <chrono>
+#include <cmath>
 #include <optional>
 
 #include "core/device_buffer.h"
+#include "engine/context_surfaces.h"
 #include "engine/importance.h"
 #include "optimize/extinction_optimizer.h"
 #include "render/renderer.h"
@@ -33,6 +35,12 @@ struct Engine::Impl {
   int lightGridSize = 0, lightGridDepth = -1;
 
   std::optional<Field3D> importance;
+  Engine::ImportanceSource importanceSource;
+  std::vector<ContextSurfaceSpec> surfaceSpecs;
+  std::vector<Field3D> surfaceBases;
+  LevelSetSettings levelSet;
+  std::optional<Field3D> worldMask;
+  ImportanceLens lens;
   ExtinctionSettings extinctionSettings;
   ExtinctionOptimizer optimizer{&ledger, Precision::FP32};
   bool frozen = false;
@@ -44,6 +52,10 @@ struct Engine::Impl {
   void clearScene() {
     optimizer.reset();
     importance.reset();
+    importanceSource = {};
+    surfaceSpecs.clear();
+    surfaceBases.clear();
+    worldMask.reset();
     volume.reset();
     frozen = false;
   }
@@ -62,6 +74,10 @@ struct Engine::Impl {
     in.light = light;
     in.imageWidth = viewportWidth;
     in.imageHeight = viewportHeight;
+    for (const auto& b : surfaceBases) in.surfaceBases.push_back(&b);
+    in.levelSet = levelSet;
+    in.worldMask = worldMask ? &*worldMask : nullptr;
+    in.lens = lens;
     return in;
   }
 
@@ -146,6 +162,7 @@ void Engine::loadBuiltinScene(const std::string& name, int resolution) {
   impl_->clearScene();
   BuiltinScene scene = makeBuiltinScene(name, resolution, impl_->precision, &impl_->ledger);
   impl_->volume.emplace(std::move(scene.volume));
+  impl_->importanceSource.kind = ImportanceSource::Kind::Scene;
   if (!scene.importance.empty())
     impl_->importance.emplace(std::move(scene.importance));
   else if (!scene.importanceCurve.empty())
@@ -214,11 +231,92 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
 
 const MemoryLedger& Engine::ledger() const { return impl_->ledger; }
 
+int Engine::addContextSurface(const ContextSurfaceSpec& spec, const ProgressCallback& progress) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its context surfaces");
+  if (impl_->surfaceBases.size() >= 4)
+    throw Error(ErrorKind::Usage, "at most 4 context surfaces are supported");
+  impl_->surfaceBases.push_back(buildContextSurface(spec, *impl_->volume, impl_->levelSet,
+                                                    impl_->precision, &impl_->ledger, progress));
+  impl_->surfaceSpecs.push_back(spec);
+  impl_->optimizer.reset();
+  impl_->lightDirty = true;
+  return int(impl_->surfaceSpecs.size()) - 1;
+}
+
+void Engine::clearContextSurfaces() {
+  impl_->surfaceSpecs.clear();
+  impl_->surfaceBases.clear();
+  impl_->optimizer.reset();
+  impl_->lightDirty = true;
+}
+
+const std::vector<ContextSurfaceSpec>& Engine::contextSurfaces() const {
+  return impl_->surfaceSpecs;
+}
+
+void Engine::setContextSurfaceVisible(int index, bool visible) {
+  if (index < 0 || index >= int(impl_->surfaceSpecs.size()))
+    throw Error(ErrorKind::Usage, "no context surface " + std::to_string(index));
+  impl_->surfaceSpecs[size_t(index)].visible = visible;
+  impl_->lightDirty = true;
+}
+
+const Field3D* Engine::contextSurfacePhi(int index) const {
+  if (index < 0 || index >= int(impl_->surfaceBases.size())) return nullptr;
+  auto optimized = impl_->optimizer.surfaces();
+  if (size_t(index) < optimized.size()) return optimized[size_t(index)];
+  return &impl_->surfaceBases[size_t(index)];
+}
+
+const Field3D* Engine::contextSurfaceBase(int index) const {
+  if (index < 0 || index >= int(impl_->surfaceBases.size())) return nullptr;
+  return &impl_->surfaceBases[size_t(index)];
+}
+
+void Engine::setLevelSetSettings(const LevelSetSettings& settings) { impl_->levelSet = settings; }
+const LevelSetSettings& Engine::levelSetSettings() const { return impl_->levelSet; }
+
+void Engine::loadWorldMask(const std::string& path) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before a mask");
+  Volume m = readVolume(path, Precision::FP32, nullptr);
+  if (m.grid().dims != impl_->volume->grid().dims)
+    throwBadInput(path, "the mask's dimensions differ from the data's");
+  Field3D mask("world-mask", impl_->volume->grid(), impl_->precision, nullptr);
+  for (size_t i = 0; i < mask.size(); ++i)
+    mask.set(i, m.toValue(m.normalized.get(i)) != 0.0 ? 1.f : 0.f);
+  setWorldMask(std::move(mask));
+}
+
+void Engine::setWorldMask(Field3D mask) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before a mask");
+  if (mask.grid().dims != impl_->volume->grid().dims)
+    throw Error(ErrorKind::Usage, "the mask must be on the volume's grid");
+  impl_->worldMask.reset();
+  impl_->worldMask.emplace("world-mask", impl_->volume->grid(), impl_->precision, &impl_->ledger);
+  for (size_t i = 0; i < mask.size(); ++i) impl_->worldMask->set(i, mask.get(i));
+}
+
+void Engine::clearWorldMask() { impl_->worldMask.reset(); }
+const Field3D* Engine::worldMask() const {
+  return impl_->worldMask ? &*impl_->worldMask : nullptr;
+}
+
+void Engine::setLens(const ImportanceLens& lens) {
+  if (!std::isfinite(lens.radius) || lens.radius < 0.f || !std::isfinite(lens.strength) ||
+      lens.strength < 0.f || !std::isfinite(lens.x) || !std::isfinite(lens.y))
+    throw Error(ErrorKind::Usage, "the lens needs a finite position, radius >= 0, strength >= 0");
+  impl_->lens = lens;
+}
+const ImportanceLens& Engine::lens() const { return impl_->lens; }
+
+const Field3D* Engine::importanceBehind() const { return impl_->optimizer.importanceBehind(); }
+
 void Engine::setImportanceCurve(const std::vector<glm::dvec2>& points, const std::string& origin) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its importance");
   impl_->importance.reset();
   impl_->importance.emplace(importanceFromCurve(*impl_->volume, points, origin, impl_->precision,
                                                 &impl_->ledger));
+  impl_->importanceSource = {ImportanceSource::Kind::Curve, points, {}};
   impl_->optimizer.reset();
 }
 
@@ -231,7 +329,12 @@ void Engine::loadImportance(const std::string& path) {
   Field3D g = importanceFromVolumeFile(*impl_->volume, path, impl_->precision, &impl_->ledger);
   impl_->importance.reset();
   impl_->importance.emplace(std::move(g));
+  impl_->importanceSource = {ImportanceSource::Kind::Volume, {}, path};
   impl_->optimizer.reset();
+}
+
+const Engine::ImportanceSource& Engine::importanceSource() const {
+  return impl_->importanceSource;
 }
 
 bool Engine::hasImportance() const { return impl_->importance.has_value(); }

@@ -14,6 +14,12 @@
 // re-samples mu and g rather than buffering the ray, so it needs no per-ray scratch memory on
 // either backend. Each ray also returns its contributions to the energy and to the
 // importance-weighted visibility V = sum g mu T dV / sum g mu dV.
+//
+// Context surfaces (paper 000 §III) are opaque: from the first cell inside their union (phi < 0)
+// on, T = 0, so the volume behind a surface is neither seen nor lit and gets no derivative.
+// View rays may carry screen-space weights (lens, windowing masks: Fig. 8) that multiply g.
+// When `behindMax` is given, the backward pass also stores the running maximum of g strictly
+// behind each cell — half of ghat in Eq. 19.
 #pragma once
 
 #include <cmath>
@@ -22,6 +28,8 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
+#include "kernels/screen_weights.h"
+#include "kernels/surface_set.h"
 
 namespace visopt {
 
@@ -37,6 +45,9 @@ struct VisibilityScan {
   FieldView mu;          // extinction on the object grid
   FieldView importance;  // g on the object grid
   FieldView out;         // d on the frustum grid; T is kept there between the two passes
+  SurfaceSet surfaces;   // opaque context surfaces on the object grid (may be empty)
+  ScreenWeights weights; // view rays only
+  FieldView behindMax;   // optional: max of g behind each cell, on the frustum grid
 
   // Pixel solid angle (for cell volumes): the tan-plane area over (1 + u^2 + v^2)^(3/2).
   VISOPT_HD float solidAngle(int i, int j) const {
@@ -49,7 +60,8 @@ struct VisibilityScan {
   }
 
   // mu and g at a cell centre; zero outside the volume's box.
-  VISOPT_HD VISOPT_INLINE bool sampleAt(int i, int j, int k, float& m, float& g) const {
+  // opaque: the cell centre lies inside a context surface.
+  VISOPT_HD VISOPT_INLINE bool sampleAt(int i, int j, int k, float& m, float& g, bool& opaque) const {
     const glm::vec3 idx = volume.toIndex(frustum.toWorld(glm::vec3(float(i), float(j), float(k))));
     // The volume occupies its voxels' cells, [-0.5, dims - 0.5] in index space (sampling clamps
     // beyond the outer voxel centres), so every voxel, boundary voxels included, is covered by
@@ -57,10 +69,12 @@ struct VisibilityScan {
     const glm::vec3 lo(-0.5f), hi = glm::vec3(volume.dims) - 0.5f;
     if (idx.x < lo.x || idx.y < lo.y || idx.z < lo.z || idx.x > hi.x || idx.y > hi.y || idx.z > hi.z) {
       m = g = 0.f;
+      opaque = false;
       return false;
     }
     m = mu.sample(idx);
     g = importance.sample(idx);
+    opaque = !surfaces.empty() && surfaces.unionAt(idx) < 0.f;
     return true;
   }
 
@@ -68,21 +82,32 @@ struct VisibilityScan {
     const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
     const int nz = frustum.dims.z;
     const float ds = frustum.ds;
-    // Front to back: exclusive transmittance.
+    const float w = weights.active() ? weights.at(i, j, frustum.dims.x, frustum.dims.y) : 1.f;
+    // Front to back: exclusive transmittance; a surface blocks everything from its first cell.
     float opticalDepth = 0.f;
+    bool blocked = false;
     for (int k = 0; k < nz; ++k) {
       float m, g;
-      sampleAt(i, j, k, m, g);
-      out.store(out.index(i, j, k), expf(-opticalDepth));
+      bool opaque;
+      sampleAt(i, j, k, m, g, opaque);
+      blocked = blocked || opaque;
+      out.store(out.index(i, j, k), blocked ? 0.f : expf(-opticalDepth));
       opticalDepth += m * ds;
     }
     // Back to front: G (behind, weighted by s^2) and d = g T - G.
     const float omega = solidAngle(i, j);
     ScanSums sums;
     float behind = 0.f;  // sum_{j>k} g mu T s^2 ds
+    float runningMax = 0.f;  // max_{j>k} g
     for (int k = nz - 1; k >= 0; --k) {
       float m, g;
-      sampleAt(i, j, k, m, g);
+      bool opaque;
+      sampleAt(i, j, k, m, g, opaque);
+      g = fminf(g * w, 1.f);
+      if (behindMax.valid()) {
+        behindMax.store(behindMax.index(i, j, k), runningMax);
+        runningMax = fmaxf(runningMax, g);
+      }
       const size_t c = out.index(i, j, k);
       const float t = out.load(c);
       const float s = frustum.depthOf(float(k));

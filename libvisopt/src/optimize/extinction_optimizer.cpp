@@ -9,6 +9,7 @@
 #include "exec/parallel.h"
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan.h"
+#include "optimize/level_set.h"
 #include "visopt/error.h"
 
 namespace visopt {
@@ -26,18 +27,34 @@ TransferLookup lookupOf(const DeviceBuffer<glm::vec4>* t) {
 
 float voxelVolume(const GridSpec& g) { return g.spacing.x * g.spacing.y * g.spacing.z; }
 
-// Runs the visibility scan of one frustum grid into `d` (allocated or resized as needed).
+// Runs the visibility scan of one frustum grid into `d` (allocated or resized as needed), and
+// the running maximum of g behind each cell into `behindMax` when that is requested.
 ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& grid,
                   const Field3D& mu, const Field3D& importance, std::optional<Field3D>& d,
-                  const char* fieldName, Precision precision, MemoryLedger* ledger) {
-  if (!d || d->grid().dims != frustum.dims) {
-    d.reset();
-    GridSpec fg;
-    fg.dims = frustum.dims;
-    d.emplace(fieldName, fg, precision, ledger);
+                  const char* fieldName, Precision precision, MemoryLedger* ledger,
+                  const SurfaceSet& surfaces = {}, const ScreenWeights& weights = {},
+                  std::optional<Field3D>* behindMax = nullptr, const char* maxName = nullptr) {
+  auto ensure = [&](std::optional<Field3D>& f, const char* fname) {
+    if (!f || f->grid().dims != frustum.dims) {
+      f.reset();
+      GridSpec fg;
+      fg.dims = frustum.dims;
+      f.emplace(fname, fg, precision, ledger);
+    }
+  };
+  ensure(d, fieldName);
+  VisibilityScan scan;
+  scan.frustum = FrustumMap(frustum);
+  scan.volume = GridMap(grid);
+  scan.mu = FieldView(mu);
+  scan.importance = FieldView(importance);
+  scan.out = FieldView(*d);
+  scan.surfaces = surfaces;
+  scan.weights = weights;
+  if (behindMax) {
+    ensure(*behindMax, maxName);
+    scan.behindMax = FieldView(**behindMax);
   }
-  VisibilityScan scan{FrustumMap(frustum), GridMap(grid), FieldView(mu), FieldView(importance),
-                      FieldView(*d)};
   return exec::reduce(name, int64_t(frustum.dims.x) * frustum.dims.y, ScanSums{}, scan,
                       [] VISOPT_HD(const ScanSums& a, const ScanSums& b) { return a + b; });
 }
@@ -121,6 +138,10 @@ struct ExtinctionOptimizer::Level {
   std::optional<Field3D> mu, base, importance;  // base/importance only on coarse levels
   std::optional<Field3D> m1, m2, rms;
   std::optional<Field3D> dView, dLight;
+  // Context surfaces: phi per surface, phi0 on coarse levels (the finest uses the inputs'),
+  // the world mask on coarse levels, ghat, the frustum maxima of g and level-set scratch.
+  std::vector<Field3D> phi, phi0;
+  std::optional<Field3D> mask, ghat, viewMax, lightMax, scratch;
   FrustumGrid view, light;
   int shrink = 1;  // frustum grids are this many times coarser than at the finest level
   int t = 0;  // optimiser steps taken on this level
@@ -138,6 +159,17 @@ const Field3D* ExtinctionOptimizer::extinction() const {
 
 void ExtinctionOptimizer::reset() { level_.reset(); }
 
+std::vector<const Field3D*> ExtinctionOptimizer::surfaces() const {
+  std::vector<const Field3D*> out;
+  if (level_ && level_->finest)
+    for (const auto& p : level_->phi) out.push_back(&p);
+  return out;
+}
+
+const Field3D* ExtinctionOptimizer::importanceBehind() const {
+  return level_ && level_->finest && level_->ghat ? &*level_->ghat : nullptr;
+}
+
 namespace {
 
 GridSpec levelGrid(const GridSpec& fine, int factor) {
@@ -149,6 +181,22 @@ GridSpec levelGrid(const GridSpec& fine, int factor) {
     g.spacing[a] = fine.spacing[a] * float(fine.dims[a] - 1) / float(g.dims[a] - 1);
   }
   return g;
+}
+
+struct DeviationSums {
+  double sum = 0, max = 0, count = 0;
+};
+
+// Trilinear resampling of `src` (on the grid `srcMap`) onto `dst`'s grid.
+void resample(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
+  const FieldView from(src), to(dst);
+  const GridMap map(dst.grid());
+  exec::parallelFor("multigrid resample", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
+    const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+              k = int(v / (int64_t(map.dims.x) * map.dims.y));
+    to.store(size_t(v),
+             from.sample(srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))))));
+  });
 }
 
 float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s, Precision p) {
@@ -219,6 +267,30 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     exec::parallelFor("extinction init", int64_t(grid.voxelCount()),
                       [=] VISOPT_HD(int64_t v) { mu.store(size_t(v), base.at(size_t(v))); });
   }
+  // Context surfaces: phi0 resampled onto coarse levels, phi prolonged from the previous level
+  // (or phi0 at the first level).
+  const GridMap fineMap(fine);
+  for (size_t si = 0; si < in.surfaceBases.size(); ++si) {
+    const Field3D& base = *in.surfaceBases[si];
+    if (!next->finest) {
+      next->phi0.emplace_back("surface-base (coarse)", grid, precision_, ledger_);
+      resample(base, fineMap, next->phi0.back());
+    }
+    next->phi.emplace_back("surface", grid, precision_, ledger_);
+    if (level_ && si < level_->phi.size())
+      resample(level_->phi[si], GridMap(level_->grid), next->phi.back());
+    else
+      resample(next->finest ? base : next->phi0.back(), next->finest ? fineMap : map,
+               next->phi.back());
+  }
+  if (!in.surfaceBases.empty()) {
+    next->ghat.emplace("importance-behind", grid, precision_, ledger_);
+    next->scratch.emplace("surface-scratch", grid, precision_, ledger_);
+    if (in.worldMask && !next->finest) {
+      next->mask.emplace("world-mask (coarse)", grid, precision_, ledger_);
+      resample(*in.worldMask, fineMap, *next->mask);
+    }
+  }
   level_.reset();
   level_ = std::move(next);
   (void)s;
@@ -261,16 +333,32 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
 
   IterationStats st;
   st.level = L.index;
+  const bool hasSurfaces = !L.phi.empty();
+  SurfaceSet surfaces;
+  for (size_t si = 0; si < L.phi.size() && si < size_t(kMaxContextSurfaces); ++si)
+    surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
+  ScreenWeights weights;
+  if (in.lens.radius > 0.f) {
+    weights.lensCentre = glm::vec2(in.lens.x, in.lens.y);
+    // The radius is a fraction of the image width; the weights work in [0,1]^2 per axis, so
+    // the circle is stretched back to round for non-square images by the aspect below.
+    weights.lensRadius = in.lens.radius;
+    weights.lensStrength = in.lens.strength;
+  }
   auto t0 = Clock::now();
   ScanSums view, light;
-  if (p.q != 0.f)
+  if (p.q != 0.f || hasSurfaces)
     view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, L.dView,
-                    "view-derivative", precision_, ledger_);
+                    "view-derivative", precision_, ledger_, surfaces, weights,
+                    hasSurfaces ? &L.viewMax : nullptr, "view-importance-behind");
   else
     L.dView.reset();
   if (p.r != 0.f)
     light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
-                     "light-derivative", precision_, ledger_);
+                     "light-derivative", precision_, ledger_, surfaces, ScreenWeights{},
+                     hasSurfaces ? &L.lightMax : nullptr, "light-importance-behind");
+  else
+    L.lightMax.reset();
   st.gridUpdatesMs = msSince(t0);
 
   // Optimiser state, allocated on the first step of a level.
@@ -342,7 +430,70 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   st.visibilityView = view.gMu > 0 ? view.gMuT / view.gMu : 0.0;
   st.visibilityLight = light.gMu > 0 ? light.gMuT / light.gMu : 0.0;
   st.stepNorm = std::sqrt(sums.step2 / double(L.grid.voxelCount()));
+  if (hasSurfaces) surfaceStep(in, L, st);
   return st;
+}
+
+void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, IterationStats& st) {
+  // ghat (Eq. 19): half the max importance behind x along the view ray, half along the light
+  // ray; without the light term (r = 0, no light grids) the view ray alone.
+  auto t0 = Clock::now();
+  const GridMap map(L.grid);
+  FieldView ghat(*L.ghat);
+  const FrustumMap view(L.view), light(L.light);
+  const FieldView viewMax = L.viewMax ? FieldView(*L.viewMax) : FieldView();
+  const FieldView lightMax = L.lightMax ? FieldView(*L.lightMax) : FieldView();
+  exec::parallelFor("grid updates: importance behind", int64_t(L.grid.voxelCount()),
+                    [=] VISOPT_HD(int64_t v) {
+                      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+                                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+                      const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
+                      const float vm = gatherFrustum(view, viewMax, x);
+                      const float g = lightMax.valid()
+                                          ? 0.5f * vm + 0.5f * gatherFrustum(light, lightMax, x)
+                                          : vm;
+                      ghat.store(size_t(v), fminf(fmaxf(g, 0.f), 1.f));
+                    });
+  const Field3D* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
+  LevelSetStepStats ls;
+  for (size_t si = 0; si < L.phi.size(); ++si) {
+    const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
+    ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, in.levelSet, *L.scratch);
+  }
+  st.sdfStepMs = msSince(t0);
+  st.levelSetTimeStep = ls.timeStep;
+
+  auto t1 = Clock::now();
+  for (auto& phi : L.phi) {
+    RedistanceStats rs = redistance(phi, in.levelSet, *L.scratch);
+    st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
+    st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
+  }
+  st.redistanceMs = msSince(t1);
+
+  // Deviation of the current surfaces from their base, over voxels on the current surface.
+  const float h = L.grid.minSpacing();
+  for (size_t si = 0; si < L.phi.size(); ++si) {
+    const FieldView phi(L.phi[si]);
+    const FieldView base(L.finest ? *in.surfaceBases[si] : L.phi0[si]);
+    const DeviationSums d = exec::reduce(
+        "surface deviation", int64_t(L.grid.voxelCount()), DeviationSums{},
+        [=] VISOPT_HD(int64_t v) {
+          DeviationSums r;
+          if (fabsf(phi.load(size_t(v))) <= 0.5f * h) {
+            const double dev = fabsf(base.load(size_t(v))) / h;
+            r.sum = dev;
+            r.max = dev;
+            r.count = 1;
+          }
+          return r;
+        },
+        [] VISOPT_HD(const DeviationSums& a, const DeviationSums& b) {
+          return DeviationSums{a.sum + b.sum, a.max > b.max ? a.max : b.max, a.count + b.count};
+        });
+    st.maxDeviationVoxels = std::max(st.maxDeviationVoxels, d.max);
+    if (d.count > 0) st.meanDeviationVoxels = std::max(st.meanDeviationVoxels, d.sum / d.count);
+  }
 }
 
 namespace {

@@ -13,6 +13,7 @@
 #include "visopt/camera.h"
 #include "visopt/field.h"
 #include "visopt/frustum.h"
+#include "visopt/level_set.h"
 #include "visopt/memory_ledger.h"
 #include "visopt/optimization.h"
 #include "visopt/volume.h"
@@ -27,6 +28,11 @@ struct OptimizationInputs {
   Camera camera;
   PointLight light;
   int imageWidth = 512, imageHeight = 512;
+  // Context surfaces: base SDFs phi0 on the volume grid (filled, or already a thin shell).
+  std::vector<const Field3D*> surfaceBases;
+  LevelSetSettings levelSet;
+  const Field3D* worldMask = nullptr;  // > 0.5: surfaces keep their base shape there
+  ImportanceLens lens;
 };
 
 // Returning false from the callback stops the run after that iteration.
@@ -73,6 +79,10 @@ class ExtinctionOptimizer {
                                       const IterationCallback& callback);
   // The optimised extinction on the volume grid, or null before any run.
   const Field3D* extinction() const;
+  // The optimised context surfaces phi on the volume grid (one per base), empty before any run.
+  std::vector<const Field3D*> surfaces() const;
+  // ghat (Eq. 19) on the volume grid from the last iteration, when there are surfaces.
+  const Field3D* importanceBehind() const;
   void reset();
 
  // Internal steps; public only because nvcc forbids extended device lambdas in private members.
@@ -81,6 +91,7 @@ class ExtinctionOptimizer {
                   int levels);
   IterationStats runIteration(const OptimizationInputs& in, const ExtinctionSettings& settings,
                               int levels, int cap);
+  void surfaceStep(const OptimizationInputs& in, Level& level, IterationStats& stats);
 
  private:
   MemoryLedger* ledger_;

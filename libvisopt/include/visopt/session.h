@@ -1,0 +1,188 @@
+// Sessions: everything a user set, saved to one JSON file and rebuilt into an Engine.
+//
+// The format is owned by the library so the CLI and the workstation share it. It follows the
+// Inviwo model: a file stores only values that differ from the defaults (plus the format and its
+// version), and older versions load through a chain of converters, each raising the version by
+// one. Data files are not copied into the session: a DataReference names each by absolute path,
+// by path relative to the session file, and by content hash (SHA-256), tried in that order. A
+// missing or changed file is reported (SessionLoadReport), never fatal. The world mask, which a
+// user may have painted for an hour, is stored inside the file (bit-packed, zstd, base64).
+//
+// Saving is atomic (temporary sibling, fsync, rename): a crash mid-save leaves the previous file
+// intact. Loading a truncated, corrupt, foreign or newer-version file throws
+// Error(BadInput, "PATH: problem").
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "visopt/camera.h"
+#include "visopt/engine.h"
+#include "visopt/level_set.h"
+#include "visopt/optimization.h"
+#include "visopt/precision.h"
+#include "visopt/progress.h"
+#include "visopt/render_settings.h"
+#include "visopt/transfer_function.h"
+
+namespace visopt {
+
+// The version sessionToJson writes. History (each step has a converter, see session_migrate):
+//   1: camera stored as an orbit {"target", "azimuth", "elevation", "distance", "fovY"}
+//   2: camera stored as {"eye", "target", "up", "fovY"}
+//   3: "tf" renamed "transferFunction", "surfaces" renamed "contextSurfaces"
+inline constexpr int kSessionFormatVersion = 3;
+
+// ---- data references ----------------------------------------------------------------------
+
+// A data file (or DICOM folder) named three ways. sha256 is lowercase hex of the file's bytes;
+// for a folder, of its regular files in name order (each: name, NUL, 8-byte little-endian size,
+// contents). `bytes` is the file size (a folder: the sum over its files).
+struct DataReference {
+  std::string absolutePath, relativePath;  // relativePath: to the session file's folder, '/'
+  std::string sha256;
+  uint64_t bytes = 0;
+  bool empty() const { return absolutePath.empty() && relativePath.empty(); }
+  bool operator==(const DataReference&) const = default;
+};
+
+// Describes `path` (made absolute) for a session to be saved at `sessionPath` (relativePath stays
+// empty when sessionPath is empty). Hashes the content; results are cached per (path, size,
+// modification time) for the life of the process. Throws BadInput when `path` is unreadable.
+DataReference makeDataReference(const std::string& path, const std::string& sessionPath);
+// Recomputes relativePath for a session saved at a new place.
+DataReference rebaseDataReference(DataReference ref, const std::string& sessionPath);
+
+enum class DataStatus {
+  Ok,          // found at its absolute path, same content
+  Moved,       // found through its path relative to the session, same content
+  Changed,     // found, but its content hash differs (still used unless the caller refuses)
+  Missing,     // found nowhere
+  Unreadable,  // found, but reading it failed (message says why)
+};
+const char* toString(DataStatus status);
+
+struct DataResolution {
+  DataStatus status = DataStatus::Missing;
+  std::string resolvedPath;  // empty when Missing
+};
+// Absolute path first, then the relative path against the session's folder; a candidate whose
+// hash matches wins over one that exists with other content.
+DataResolution resolveDataReference(const DataReference& ref, const std::string& sessionPath);
+
+// ---- the session ---------------------------------------------------------------------------
+
+// A binary mask on the volume grid, bit-packed: bit i (x fastest, LSB first) is voxel i.
+struct SessionMask {
+  glm::ivec3 dims{0};
+  std::vector<uint8_t> bits;  // (voxelCount + 7) / 8 bytes
+  size_t voxelCount() const;
+  bool get(size_t i) const { return (bits[i >> 3] >> (i & 7)) & 1u; }
+  void set(size_t i, bool v);
+  bool operator==(const SessionMask&) const = default;
+};
+// Set where the field is > 0.5 (the level-set step's threshold).
+SessionMask packMask(const Field3D& mask);
+
+struct SessionImportance {
+  enum class Kind { None, Scene, Curve, Volume } kind = Kind::None;
+  std::vector<glm::dvec2> curve;  // Curve: (value, g) in data units
+  DataReference volume;           // Volume: the importance file
+};
+
+struct SessionSurface {
+  ContextSurfaceSpec spec;  // as the user gave it ("mesh:/old/place.obj")
+  DataReference file;       // mesh:/vdb: sources: the file; empty for iso:
+};
+
+struct Session {
+  int version = kSessionFormatVersion;  // the version the file was written with
+  // Data: a built-in scene or a volume file.
+  std::string builtinScene;  // NAME of builtin:NAME; empty: `volume` is used
+  int builtinResolution = 128;
+  DataReference volume;
+  Precision precision = Precision::FP32;
+  std::optional<TransferFunction> transferFunction;  // empty: the engine's default for the data
+  SessionImportance importance;
+  std::vector<SessionSurface> contextSurfaces;
+  ExtinctionSettings extinction;
+  LevelSetSettings levelSet;
+  std::optional<Camera> camera;      // empty: the framing the data source gives
+  std::optional<PointLight> light;
+  ImportanceLens lens;
+  RenderSettings render;  // image size, deviation view, ... (the engine does not hold them)
+  bool frozen = false;
+  std::optional<SessionMask> worldMask;
+};
+
+// Reads the engine's state. `render` is the caller's render settings (the workstation's view).
+// Data files are hashed (cached); references are made relative to `sessionPath` (may be empty;
+// saveSession rebases them to where the file goes). Throws Usage when the engine has no volume.
+Session captureSession(const Engine& engine, const RenderSettings& render = {},
+                       const std::string& sessionPath = {});
+
+// One data file a session needs and what became of it.
+struct SessionDataReport {
+  std::string role;  // "volume", "importance", "context surface 1", ...
+  DataReference reference;
+  DataStatus status = DataStatus::Missing;
+  std::string resolvedPath;
+  std::string message;  // Unreadable: why
+};
+
+struct SessionLoadReport {
+  std::vector<SessionDataReport> data;
+  // Settings that could not be applied (a surface that failed to build, a mask of other dims,
+  // a precision the engine was not constructed with), one line each.
+  std::vector<std::string> warnings;
+  // False when the data source could not be loaded: the engine was left as it was.
+  bool sceneLoaded = false;
+  bool allDataFound() const;  // every reference Ok or Moved
+};
+
+struct SessionApplyOptions {
+  // A file whose content changed is still used (and reported as Changed); false skips it.
+  bool useChangedFiles = true;
+};
+
+// Resolves every data reference without touching an engine (what a workstation shows before it
+// asks the user to point to moved files).
+std::vector<SessionDataReport> checkSessionData(const Session& session,
+                                                const std::string& sessionPath);
+// Points the reference of `role` (as in SessionDataReport) at `newPath`, keeping its recorded
+// hash, so the next apply finds it (reported Ok or Changed). Throws Usage for an unknown role.
+void relocate(Session& session, const std::string& role, const std::string& newPath);
+
+// Rebuilds the session in the engine: data source, transfer function, importance, surfaces,
+// settings, camera, light, mask, frozen flag. Missing or changed data is reported, not thrown;
+// whatever can be applied is. The engine's precision is its own (a differing one is a warning).
+// Throws only Error(Cancelled) when `progress` asks to stop.
+SessionLoadReport applySession(Engine& engine, const Session& session,
+                               const std::string& sessionPath,
+                               const ProgressCallback& progress = {},
+                               const SessionApplyOptions& options = {});
+
+// ---- the file --------------------------------------------------------------------------------
+
+// JSON text of the current version; only non-default values. `sessionPath` rebases relative paths.
+std::string sessionToJson(const Session& session, const std::string& sessionPath = {});
+// Parses any version up to the current one, migrating step by step; `origin` names the source
+// in messages. Throws Error(BadInput, "ORIGIN: problem").
+Session sessionFromJson(const std::string& json, const std::string& origin);
+
+// Atomic: a temporary sibling is written, fsynced and renamed over `path`. Throws BadInput when
+// the folder does not exist, Failure when writing fails (the old file is then untouched).
+void saveSession(const Session& session, const std::string& path);
+Session loadSession(const std::string& path);
+
+// Test hook: called at the save stages "temporary-open", "mid-write" and "after-write" (before
+// the rename). The environment variable VISOPT_SESSION_FAULT=STAGE makes the process exit
+// abruptly (_Exit(70)) at that stage, as a crash would.
+using SessionSaveHook = void (*)(const char* stage);
+void setSessionSaveHook(SessionSaveHook hook);
+
+}  // namespace visopt

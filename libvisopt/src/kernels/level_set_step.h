@@ -1,0 +1,335 @@
+// One explicit Euler step of the context-surface PDE (paper 000 Eq. 23, Eq. 25, Alg. 1;
+// METHODS.md §3), per voxel:
+//   phi_t = max(0, ghat |grad phi| kappa + grad ghat . grad phi) + lambda(x) (phi0 - phi),
+//   lambda(x) = max(0, lambda - ghat(x)).
+// |grad phi| of the curvature part is Godunov-upwinded (Osher & Fedkiw §6.4) on the sign of
+// the speed F = -ghat kappa of phi_t + F |grad phi| = 0, from first-order or second-order ENO
+// one-sided differences (LevelSetSettings::spatialOrder); grad ghat . grad phi and the mean
+// curvature kappa = div(grad phi / |grad phi|) use central differences, kappa with the
+// denominator (|grad phi|^2)^(3/2) + eps and clamped to |kappa| <= kappaMax (~1 / dx_min).
+// Where the world mask is set the first term is off and phi only relaxes back to phi0.
+//
+// Boundaries: a missing neighbour is the linear extrapolation of the two nearest values, so at
+// a border the one-sided differences D- and D+ coincide, the central difference is one-sided
+// and the second difference is zero; an axis with a single voxel has no derivative at all.
+//
+// The step reads one buffer and writes another (no in-place race). Kernels get the fields
+// through an accessor type: fp32 and fp16 pointers for the fast paths, any FieldView otherwise.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "core/field_view.h"
+#include "core/half.h"
+#include "core/hd.h"
+
+namespace visopt {
+
+// fmaxf / fminf without their NaN rules: one instruction each on the CPU (g++ calls libm for
+// fmaxf unless math is relaxed), so the row loops stay branch-free.
+VISOPT_HD VISOPT_INLINE float maxOf(float a, float b) {
+  return a > b ? a : b;
+}
+VISOPT_HD VISOPT_INLINE float minOf(float a, float b) {
+  return a < b ? a : b;
+}
+
+// ---- storage accessors ------------------------------------------------------------------------
+
+struct Fp32Access {
+  float* p = nullptr;
+  VISOPT_HD VISOPT_INLINE float load(size_t i) const { return p[i]; }
+  VISOPT_HD VISOPT_INLINE void store(size_t i, float v) const { p[i] = v; }
+  VISOPT_HD VISOPT_INLINE float kept(float v) const { return v; }  // what a store keeps
+};
+
+struct Fp16Access {
+  Half* p = nullptr;
+  VISOPT_HD VISOPT_INLINE float load(size_t i) const { return halfToFloat(p[i]); }
+  // Saturates at fp16's largest finite value, as FieldView::store does.
+  VISOPT_HD VISOPT_INLINE void store(size_t i, float v) const {
+    p[i] = floatToHalf(minOf(maxOf(v, -65504.f), 65504.f));
+  }
+  VISOPT_HD VISOPT_INLINE float kept(float v) const {
+    return halfToFloat(floatToHalf(minOf(maxOf(v, -65504.f), 65504.f)));
+  }
+};
+
+struct AnyAccess {
+  FieldView f;
+  VISOPT_HD VISOPT_INLINE float load(size_t i) const { return f.load(i); }
+  VISOPT_HD VISOPT_INLINE void store(size_t i, float v) const { f.store(i, v); }
+  VISOPT_HD VISOPT_INLINE float kept(float v) const {
+    return f.half ? halfToFloat(floatToHalf(minOf(maxOf(v, -65504.f), 65504.f))) : v;
+  }
+};
+
+// ---- stencil geometry -------------------------------------------------------------------------
+
+// The neighbours of one voxel along one axis.
+struct StencilAxis {
+  int64_t m = 0, p = 0;         // linear offsets to the minus / plus neighbour (0 where missing)
+  int64_t mm = 0, pp = 0;       // ... to the second neighbours (only read where they exist)
+  float inv = 0.f;              // 1 / h; 0 for an axis of a single voxel
+  float central = 0.f;          // 1 / ((p - m) h): 1/(2h) inside, 1/h at a border, 0 for one voxel
+  bool lo = false, hi = false;  // at the minus / plus border
+  bool lo2 = false, hi2 = false;  // the minus / plus neighbour is at a border or missing
+};
+
+VISOPT_HD VISOPT_INLINE StencilAxis stencilAxis(int idx, int n, int64_t stride, float h) {
+  StencilAxis a;
+  if (n <= 1) {
+    a.lo = a.hi = a.lo2 = a.hi2 = true;
+    return a;
+  }
+  a.lo = idx == 0;
+  a.hi = idx == n - 1;
+  a.lo2 = idx <= 1;
+  a.hi2 = idx >= n - 2;
+  a.m = a.lo ? 0 : -stride;
+  a.p = a.hi ? 0 : stride;
+  a.mm = a.lo2 ? a.m : -2 * stride;
+  a.pp = a.hi2 ? a.p : 2 * stride;
+  a.inv = 1.f / h;
+  a.central = (a.lo || a.hi) ? a.inv : 0.5f * a.inv;
+  return a;
+}
+
+// One-sided differences D-, D+ with the border extrapolation described above.
+struct OneSided {
+  float dm, dp;
+};
+VISOPT_HD VISOPT_INLINE OneSided oneSided(float m, float c, float p, const StencilAxis& a) {
+  float dm = (c - m) * a.inv, dp = (p - c) * a.inv;
+  if (a.lo) dm = dp;
+  if (a.hi) dp = dm;
+  return {dm, dp};
+}
+
+VISOPT_HD VISOPT_INLINE float minmod(float a, float b) {
+  return a * b > 0.f ? (fabsf(a) < fabsf(b) ? a : b) : 0.f;
+}
+
+// Second-order ENO one-sided differences (Osher & Fedkiw §3.3): the first-order ones plus half
+// the smaller (minmod) of the two adjacent second differences. Second differences that would
+// need a value beyond the border are 0 (linear extrapolation), so borders fall back to first
+// order, and so do kinks, where the two second differences disagree in sign.
+VISOPT_HD VISOPT_INLINE OneSided oneSidedEno2(float mm, float m, float c, float p, float pp,
+                                              const StencilAxis& a) {
+  const float d2c = (a.lo || a.hi) ? 0.f : p - 2.f * c + m;
+  const float d2m = a.lo2 ? 0.f : c - 2.f * m + mm;
+  const float d2p = a.hi2 ? 0.f : pp - 2.f * p + c;
+  float dm = (c - m + 0.5f * minmod(d2m, d2c)) * a.inv;
+  float dp = (p - c - 0.5f * minmod(d2p, d2c)) * a.inv;
+  if (a.lo) dm = dp;
+  if (a.hi) dp = dm;
+  return {dm, dp};
+}
+
+// The upwind differences of the given order (1 or 2) along one axis.
+template <class A, int Order>
+VISOPT_HD VISOPT_INLINE OneSided upwindDifferences(const A& f, int64_t s, float m, float c, float p,
+                                                   const StencilAxis& a) {
+  if constexpr (Order == 2)
+    return oneSidedEno2(f.load(size_t(s + a.mm)), m, c, p, f.load(size_t(s + a.pp)), a);
+  else
+    return oneSided(m, c, p, a);
+}
+
+// Godunov's upwind |D phi|^2 along one axis for a speed of the given sign (phi_t + F|grad phi|).
+VISOPT_HD VISOPT_INLINE float godunovSquared(const OneSided& d, bool positiveSpeed) {
+  const float a = positiveSpeed ? maxOf(d.dm, 0.f) : minOf(d.dm, 0.f);
+  const float b = positiveSpeed ? minOf(d.dp, 0.f) : maxOf(d.dp, 0.f);
+  return maxOf(a * a, b * b);
+}
+
+// Per-launch reduction of a step: largest and summed |delta phi|.
+struct ChangeSums {
+  float maxAbs = 0.f;
+  double sumAbs = 0.0;
+  double sumSquared = 0.0;
+  VISOPT_HD ChangeSums operator+(const ChangeSums& o) const {
+    return {maxOf(maxAbs, o.maxAbs), sumAbs + o.sumAbs, sumSquared + o.sumSquared};
+  }
+  VISOPT_HD void add(float d) {
+    const float a = fabsf(d);
+    maxAbs = maxOf(maxAbs, a);
+    sumAbs += double(a);
+    sumSquared += double(d) * double(d);
+  }
+};
+
+// ---- sweeping the grid ------------------------------------------------------------------------
+//
+// A stencil kernel K provides dims, spacing, current(v) (the value it replaces), next(v, ax, ay,
+// az) (the new value, branch-free), write(v, value) and kept(value) (what storage keeps).
+// sweepVoxel runs one voxel (the CUDA path); sweepRow one x row (the CPU path): the y/z stencil
+// is fixed along a row, the two voxels at either end use the border stencil, and the interior
+// runs in chunks of kLanes with a fixed x stencil and per-lane accumulators, so that the
+// compiler can vectorise it.
+
+template <class K>
+VISOPT_HD ChangeSums sweepVoxel(const K& k, int64_t v) {
+  const int64_t nx = k.dims.x, ny = k.dims.y;
+  const int i = int(v % nx), j = int((v / nx) % ny), l = int(v / (nx * ny));
+  const float c = k.current(size_t(v));
+  const float next = k.next(size_t(v), stencilAxis(i, k.dims.x, 1, k.spacing.x),
+                            stencilAxis(j, k.dims.y, nx, k.spacing.y),
+                            stencilAxis(l, k.dims.z, nx * ny, k.spacing.z));
+  k.write(size_t(v), next);
+  ChangeSums sums;
+  sums.add(k.kept(next) - c);
+  return sums;
+}
+
+template <class K>
+VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
+  constexpr int kLanes = 16;
+  const int nx = k.dims.x;
+  const int64_t ny = k.dims.y;
+  const StencilAxis ay = stencilAxis(int(r % ny), k.dims.y, nx, k.spacing.y);
+  const StencilAxis az = stencilAxis(int(r / ny), k.dims.z, int64_t(nx) * ny, k.spacing.z);
+  const StencilAxis inner = stencilAxis(2, 5, 1, k.spacing.x);  // no border within reach
+  const size_t base = size_t(r) * size_t(nx);
+  ChangeSums sums;
+  auto single = [&](int i, const StencilAxis& ax) {
+    const size_t v = base + size_t(i);
+    const float c = k.current(v);
+    const float next = k.next(v, ax, ay, az);
+    k.write(v, next);
+    sums.add(k.kept(next) - c);
+  };
+  const int lo = nx < 2 ? nx : 2;
+  const int hi = nx - 2 > lo ? nx - 2 : lo;
+  for (int i = 0; i < lo; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
+  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes];
+  for (int l = 0; l < kLanes; ++l) maxAbs[l] = sumAbs[l] = sumSquared[l] = 0.f;
+  int i = lo;
+  for (; i + kLanes <= hi; i += kLanes) {
+    const size_t v0 = base + size_t(i);
+    for (int l = 0; l < kLanes; ++l) {
+      const size_t v = v0 + size_t(l);
+      const float c = k.current(v);
+      const float next = k.next(v, inner, ay, az);
+      k.write(v, next);
+      const float d = k.kept(next) - c;
+      maxAbs[l] = maxOf(maxAbs[l], fabsf(d));
+      sumAbs[l] += fabsf(d);
+      sumSquared[l] += d * d;
+    }
+  }
+  for (; i < hi; ++i) single(i, inner);
+  for (; i < nx; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
+  for (int l = 0; l < kLanes; ++l) {
+    sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
+    sums.sumAbs += double(sumAbs[l]);
+    sums.sumSquared += double(sumSquared[l]);
+  }
+  return sums;
+}
+
+// ---- the level-set step -----------------------------------------------------------------------
+
+template <class A, int Order>
+struct LevelSetStepKernel {
+  A phi, out, phi0, ghat;
+  // The world mask: masked where mask > maskThreshold. Without a mask, `mask` reads ghat and
+  // the threshold is infinite (one code path, no conditional loads).
+  A mask;
+  float maskThreshold = 3.4e38f;
+  glm::ivec3 dims{1};
+  glm::vec3 spacing{1.f};
+  float dt = 0.f;
+  float lambda = 0.f;
+  float curvatureEpsilon = 1e-6f;
+  float kappaMax = 1.f;
+
+  VISOPT_HD VISOPT_INLINE float current(size_t v) const { return phi.load(v); }
+  VISOPT_HD VISOPT_INLINE void write(size_t v, float x) const { out.store(v, x); }
+  VISOPT_HD VISOPT_INLINE float kept(float x) const { return out.kept(x); }
+
+  VISOPT_HD VISOPT_INLINE float next(size_t v, const StencilAxis& ax, const StencilAxis& ay,
+                                     const StencilAxis& az) const {
+    const int64_t s = int64_t(v);
+    const float c = phi.load(v);
+    const float xm = phi.load(size_t(s + ax.m)), xp = phi.load(size_t(s + ax.p));
+    const float ym = phi.load(size_t(s + ay.m)), yp = phi.load(size_t(s + ay.p));
+    const float zm = phi.load(size_t(s + az.m)), zp = phi.load(size_t(s + az.p));
+    const float g = ghat.load(v);
+    const bool masked = mask.load(v) > maskThreshold;
+
+    const OneSided dx = oneSided(xm, c, xp, ax), dy = oneSided(ym, c, yp, ay),
+                   dz = oneSided(zm, c, zp, az);
+    // Central first and second derivatives; mixed ones as central differences of central
+    // differences (the border rule makes them one-sided there).
+    const float px = (xp - xm) * ax.central, py = (yp - ym) * ay.central,
+                pz = (zp - zm) * az.central;
+    const float pxx = (dx.dp - dx.dm) * ax.inv, pyy = (dy.dp - dy.dm) * ay.inv,
+                pzz = (dz.dp - dz.dm) * az.inv;
+    auto mixed = [&](const StencilAxis& a, const StencilAxis& b) {
+      const float pp = phi.load(size_t(s + a.p + b.p)), pm = phi.load(size_t(s + a.p + b.m));
+      const float mp = phi.load(size_t(s + a.m + b.p)), mm = phi.load(size_t(s + a.m + b.m));
+      return (pp - pm - mp + mm) * a.central * b.central;
+    };
+    const float pxy = mixed(ax, ay), pxz = mixed(ax, az), pyz = mixed(ay, az);
+    const float px2 = px * px, py2 = py * py, pz2 = pz * pz;
+    const float grad2 = px2 + py2 + pz2;
+    const float num = px2 * (pyy + pzz) + py2 * (pxx + pzz) + pz2 * (pxx + pyy) -
+                      2.f * (px * py * pxy + px * pz * pxz + py * pz * pyz);
+    float kappa = num / (grad2 * sqrtf(grad2) + curvatureEpsilon);
+    kappa = minOf(maxOf(kappa, -kappaMax), kappaMax);
+
+    // phi_t = g kappa |grad phi| is phi_t + F |grad phi| = 0 with F = -g kappa.
+    const bool positiveSpeed = -g * kappa > 0.f;
+    const OneSided ux = upwindDifferences<A, Order>(phi, s, xm, c, xp, ax);
+    const OneSided uy = upwindDifferences<A, Order>(phi, s, ym, c, yp, ay);
+    const OneSided uz = upwindDifferences<A, Order>(phi, s, zm, c, zp, az);
+    const float upwind =
+        sqrtf(godunovSquared(ux, positiveSpeed) + godunovSquared(uy, positiveSpeed) +
+              godunovSquared(uz, positiveSpeed));
+
+    const float gx = (ghat.load(size_t(s + ax.p)) - ghat.load(size_t(s + ax.m))) * ax.central;
+    const float gy = (ghat.load(size_t(s + ay.p)) - ghat.load(size_t(s + ay.m))) * ay.central;
+    const float gz = (ghat.load(size_t(s + az.p)) - ghat.load(size_t(s + az.m))) * az.central;
+    const float drive = masked ? 0.f : maxOf(0.f, g * upwind * kappa + gx * px + gy * py + gz * pz);
+    // The relaxation never overshoots phi0, whatever dt the caller chose.
+    const float rate = minOf(maxOf(0.f, lambda - g) * dt, 1.f);
+    return c + dt * drive + rate * (phi0.load(v) - c);
+  }
+
+  VISOPT_HD ChangeSums voxel(int64_t v) const { return sweepVoxel(*this, v); }
+  VISOPT_HD ChangeSums row(int64_t r) const { return sweepRow(*this, r); }
+};
+
+// Maxima over the grid that bound the stable time step (METHODS.md §3).
+struct StepBounds {
+  float maxGradG = 0.f;  // max |grad ghat| (central differences, world units)
+  float maxG = 0.f;      // max ghat
+  float minG = 3.4e38f;  // min ghat (max lambda(x) = max(0, lambda - min ghat))
+  VISOPT_HD StepBounds operator+(const StepBounds& o) const {
+    return {maxOf(maxGradG, o.maxGradG), maxOf(maxG, o.maxG), minOf(minG, o.minG)};
+  }
+};
+
+struct StepBoundsKernel {
+  FieldView ghat;
+  glm::ivec3 dims{1};
+  glm::vec3 spacing{1.f};
+  VISOPT_HD StepBounds operator()(int64_t v) const {
+    const int64_t nx = dims.x, ny = dims.y;
+    const int i = int(v % nx), j = int((v / nx) % ny), k = int(v / (nx * ny));
+    const StencilAxis ax = stencilAxis(i, dims.x, 1, spacing.x);
+    const StencilAxis ay = stencilAxis(j, dims.y, nx, spacing.y);
+    const StencilAxis az = stencilAxis(k, dims.z, nx * ny, spacing.z);
+    const float gx = (ghat.load(size_t(v + ax.p)) - ghat.load(size_t(v + ax.m))) * ax.central;
+    const float gy = (ghat.load(size_t(v + ay.p)) - ghat.load(size_t(v + ay.m))) * ay.central;
+    const float gz = (ghat.load(size_t(v + az.p)) - ghat.load(size_t(v + az.m))) * az.central;
+    const float g = ghat.load(size_t(v));
+    return {sqrtf(gx * gx + gy * gy + gz * gz), g, g};
+  }
+};
+
+}  // namespace visopt

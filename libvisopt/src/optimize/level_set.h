@@ -1,0 +1,54 @@
+// Host orchestration of the context-surface numerics (paper 000 §III-B-D; METHODS.md §3):
+// the level-set step of Eq. 23, redistancing (Eq. 18), an SDF from an isovalue, thin shells
+// (Eq. 26). Fields are fp32 or fp16 (each Field3D's own precision); arithmetic is fp32.
+#pragma once
+
+#include "visopt/field.h"
+#include "visopt/level_set.h"
+#include "visopt/precision.h"
+#include "visopt/volume.h"
+
+namespace visopt {
+
+class MemoryLedger;
+
+// s.substeps explicit Euler substeps of Eq. 23 on phi (in place; `scratch` is the second
+// buffer, (re)allocated like phi when it does not match phi's grid and precision). Each
+// substep's dt = s.cfl x min(dx / max|grad ghat|, dx^2 / (6 max ghat), 1 / max lambda(x)),
+// dx the smallest spacing; terms whose maximum is 0 drop out, and dt is at most s.cfl x dx^2
+// (world units) when all of them do. s.cfl is clamped to (0, 1]. `mask` (nullable; > 0.5 =
+// masked) turns the occlusion term off. phi0, ghat and mask must be on phi's grid.
+LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
+                               const Field3D* mask, const LevelSetSettings& s, Field3D& scratch);
+
+// The stable dt levelSetStep would use (the same formula), for tests and callers.
+double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s);
+
+// Up to s.redistanceIterations iterations of Eq. 18 on phi (in place; scratch as above),
+// stopping early when the mean squared change per iteration (voxel units^2) falls below
+// s.redistanceTolerance; see kernels/redistance.h for the scheme (subcell fix at the interface,
+// dtau). A field without any sign change has no interface to measure distance
+// from: it is left unchanged (0 iterations, converged).
+RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch);
+
+// Single passes, for the benchmark: one Euler substep of Eq. 23 with a given dt from `phi`
+// into `out` (returns max |delta phi|), and one redistancing iteration from `in` into `out`
+// (returns the mean squared change in voxel units^2; the interface band is copied).
+double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
+                       const Field3D* mask, const LevelSetSettings& s, double dt, Field3D& out);
+double redistanceIteration(const Field3D& in, Field3D& out, int spatialOrder = 2);
+
+// phi(x, 0) = +-(s(x) - iso) / |grad s| (inside negative: with insideHigh, values above the
+// isovalue are inside), |grad s| the mean central-difference gradient magnitude over the voxels
+// next to the isosurface, then redistanced until converged (at least enough iterations for
+// the front to cross the grid's diagonal). `isovalue` is in the volume's data units. A volume
+// that never crosses the isovalue gives the scaled difference, all of one sign.
+Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
+                        const LevelSetSettings& s, Precision p, MemoryLedger* ledger);
+
+// Eq. 26: |phi0| - d, d >= 0 in world units (BadInput/Usage error for d < 0 or NaN).
+// d = 0 is an infinitely thin shell: the field is >= 0 everywhere and touches 0 only on the
+// surface, so nothing is inside. A d larger than the object fills it and grows it by d.
+Field3D thinShell(const Field3D& filled, float d, Precision p, MemoryLedger* ledger);
+
+}  // namespace visopt

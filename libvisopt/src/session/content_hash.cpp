@@ -1,0 +1,108 @@
+#include "session/content_hash.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "session/sha256.h"
+#include "visopt/error.h"
+
+namespace visopt::session {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct FileEntry {
+  std::string name;  // path for a single file, file name inside a folder
+  fs::path path;
+  uint64_t size = 0;
+  int64_t mtime = 0;
+};
+
+std::vector<FileEntry> listEntries(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throwBadInput(path, "file not found");
+  std::vector<FileEntry> entries;
+  auto describe = [&](const fs::path& p, std::string name) {
+    FileEntry e;
+    e.name = std::move(name);
+    e.path = p;
+    e.size = fs::file_size(p, ec);
+    if (ec) throwBadInput(p.string(), "cannot read its size (" + ec.message() + ")");
+    e.mtime = static_cast<int64_t>(fs::last_write_time(p, ec).time_since_epoch().count());
+    entries.push_back(std::move(e));
+  };
+  if (fs::is_directory(st)) {
+    for (const auto& entry : fs::directory_iterator(path, ec))
+      if (entry.is_regular_file(ec)) describe(entry.path(), entry.path().filename().string());
+    if (ec) throwBadInput(path, "cannot list the folder (" + ec.message() + ")");
+    std::sort(entries.begin(), entries.end(),
+              [](const FileEntry& a, const FileEntry& b) { return a.name < b.name; });
+  } else {
+    describe(path, {});
+  }
+  return entries;
+}
+
+void hashFile(Sha256& h, const fs::path& path) {
+  std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
+  if (!f) throwBadInput(path.string(), std::string("cannot open: ") + std::strerror(errno));
+  std::vector<char> buffer(1 << 20);
+  size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), f.get())) > 0) h.update(buffer.data(), n);
+  if (std::ferror(f.get())) throwBadInput(path.string(), "read error");
+}
+
+std::string signatureOf(const std::vector<FileEntry>& entries) {
+  std::string s;
+  for (const auto& e : entries)
+    s += e.name + '\0' + std::to_string(e.size) + ':' + std::to_string(e.mtime) + '\n';
+  return s;
+}
+
+struct CacheEntry {
+  std::string signature;
+  ContentHash hash;
+};
+
+}  // namespace
+
+ContentHash hashContent(const std::string& path) {
+  static std::mutex mutex;
+  static std::map<std::string, CacheEntry> cache;
+  std::error_code ec;
+  const std::string key = fs::absolute(path, ec).lexically_normal().string();
+  const std::vector<FileEntry> entries = listEntries(path);
+  const bool folder = entries.empty() || !entries.front().name.empty();
+  const std::string signature = std::string(folder ? "dir\n" : "file\n") + signatureOf(entries);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = cache.find(key);
+    if (it != cache.end() && it->second.signature == signature) return it->second.hash;
+  }
+  Sha256 h;
+  ContentHash out;
+  for (const auto& e : entries) {
+    if (folder) {
+      h.update(e.name.data(), e.name.size() + 1);  // with its NUL
+      uint8_t size[8];
+      for (int i = 0; i < 8; ++i) size[i] = uint8_t(e.size >> (8 * i));
+      h.update(size, sizeof(size));
+    }
+    hashFile(h, e.path);
+    out.bytes += e.size;
+  }
+  out.sha256 = h.hexDigest();
+  std::lock_guard<std::mutex> lock(mutex);
+  cache[key] = {signature, out};
+  return out;
+}
+
+}  // namespace visopt::session

@@ -1,0 +1,64 @@
+// Inviwo-style serialisation of plain settings structs: one table of (key, member) per struct
+// drives both directions; writing keeps only members that differ from a default-constructed
+// struct, reading starts from the defaults and overrides what the JSON holds.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "session/json_read.h"
+
+namespace visopt::session {
+
+template <class S>
+class FieldTable {
+ public:
+  using Member = std::variant<float S::*, int S::*, bool S::*, uint32_t S::*, glm::vec3 S::*>;
+
+  FieldTable& add(const char* key, Member member) {
+    fields_.emplace_back(key, member);
+    return *this;
+  }
+
+  // Only the members that differ from S{} (or from `defaults`).
+  nlohmann::json write(const S& value, const S& defaults = S{}) const {
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [key, member] : fields_)
+      std::visit(
+          [&](auto m) {
+            if (!(value.*m == defaults.*m)) out[key] = toJson(value.*m);
+          },
+          member);
+    return out;
+  }
+
+  // Every member (for values whose defaults mean nothing, like a camera).
+  nlohmann::json writeAll(const S& value) const {
+    nlohmann::json out = nlohmann::json::object();
+    for (const auto& [key, member] : fields_)
+      std::visit([&](auto m) { out[key] = toJson(value.*m); }, member);
+    return out;
+  }
+
+  // Members named in `j` override those of `out`; unknown keys are ignored (a newer minor
+  // addition), wrongly typed values throw BadInput naming `where`.
+  void read(const nlohmann::json& j, S& out, const Where& where) const {
+    expectObject(j, where);
+    for (const auto& [key, member] : fields_) {
+      auto it = j.find(key);
+      if (it == j.end()) continue;
+      std::visit([&](auto m) { readValue(*it, out.*m, where.key(key)); }, member);
+    }
+  }
+
+ private:
+  std::vector<std::pair<const char*, Member>> fields_;
+};
+
+}  // namespace visopt::session

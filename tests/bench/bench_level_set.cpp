@@ -1,0 +1,147 @@
+// Paper 000 Table I, the context-surface columns, on the CPU: "SDF Opt." (one explicit Euler
+// substep of the level-set PDE, Eq. 23) and "Redist." (one redistancing iteration, Eq. 18) on
+// dense 64^3 / 128^3 / 256^3 grids in fp32 and fp16, reported in ns per voxel-iteration; and,
+// in the same run, OpenVDB's LevelSetTracker renormalisation (first-order Godunov FIRST_BIAS,
+// Euler TVD_RK1, one normalize() iteration) on the same sphere, for a narrow band (half-width
+// 3 voxels) and for a band wide enough to cover the whole grid (clipped to it), in ns per active
+// voxel-iteration and ms per iteration. See docs/level-set-benchmarks.md.
+//
+// Counters: ns_per_voxel (wall time / voxels of the grid or active voxels of the band),
+// voxels (the count it divides by).
+#include <benchmark/benchmark.h>
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/LevelSetTracker.h>
+
+#include <cmath>
+#include <cstdint>
+
+#include "optimize/level_set.h"
+#include "visopt/field.h"
+#include "visopt/level_set.h"
+
+namespace {
+
+using visopt::Field3D;
+using visopt::GridSpec;
+using visopt::Precision;
+
+// A sphere of radius n/4 at the centre of an n^3 grid of unit voxels.
+float sphereAt(int n, int i, int j, int k) {
+  const float c = 0.5f * float(n - 1);
+  const float x = float(i) - c, y = float(j) - c, z = float(k) - c;
+  return std::sqrt(x * x + y * y + z * z) - 0.25f * float(n);
+}
+
+struct DenseSetup {
+  Field3D phi, phi0, ghat, out;
+  DenseSetup(int n, Precision p) {
+    GridSpec g;
+    g.dims = glm::ivec3(n);
+    phi = Field3D("phi", g, p);
+    phi0 = Field3D("phi0", g, p);
+    ghat = Field3D("ghat", g, p);
+    out = Field3D("out", g, p);
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const size_t v = g.linearIndex(i, j, k);
+          phi.set(v, sphereAt(n, i, j, k));
+          phi0.set(v, sphereAt(n, i, j, k) - 0.5f);
+          ghat.set(v, 0.5f + 0.4f * std::sin(0.1f * float(i)) * std::cos(0.13f * float(j)));
+          out.set(v, 0.f);
+        }
+  }
+};
+
+Precision precisionOf(int64_t code) {
+  return code == 16 ? Precision::FP16 : Precision::FP32;
+}
+
+void setCounters(benchmark::State& state, double voxels) {
+  state.counters["voxels"] = voxels;
+  state.counters["ns_per_voxel"] = benchmark::Counter(
+      voxels * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// One level-set substep (the kernel of Eq. 23, its time step computed once outside).
+void BM_SdfOpt(benchmark::State& state) {
+  const int n = int(state.range(0));
+  DenseSetup d(n, precisionOf(state.range(1)));
+  visopt::LevelSetSettings s;
+  const double dt = visopt::levelSetTimeStep(d.ghat, s);
+  for (auto _ : state) {
+    const double change = visopt::levelSetSubstep(d.phi, d.phi0, d.ghat, nullptr, s, dt, d.out);
+    benchmark::DoNotOptimize(change);
+  }
+  setCounters(state, double(d.phi.size()));
+}
+
+// One redistancing iteration (second-order ENO by default; range(2) = 1 for first order, as
+// OpenVDB's FIRST_BIAS).
+void BM_Redist(benchmark::State& state) {
+  const int n = int(state.range(0));
+  DenseSetup d(n, precisionOf(state.range(1)));
+  const int order = int(state.range(2));
+  for (auto _ : state) {
+    const double msc = visopt::redistanceIteration(d.phi, d.out, order);
+    benchmark::DoNotOptimize(msc);
+  }
+  setCounters(state, double(d.phi.size()));
+}
+
+// OpenVDB: one renormalisation iteration of LevelSetTracker, FIRST_BIAS + TVD_RK1, on the same
+// sphere; range(1) = 0: narrow band of half-width 3; 1: a band wide enough to cover the grid.
+void BM_OpenVdbRenormalize(benchmark::State& state) {
+  openvdb::initialize();
+  const int n = int(state.range(0));
+  const bool whole = state.range(1) != 0;
+  const float c = 0.5f * float(n - 1);
+  // Half-width in voxels: from the sphere (radius n/4) to the far corner of the grid.
+  const float halfWidth = whole ? std::ceil(0.25f * float(n) + std::sqrt(3.f) * c) : 3.f;
+  auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+      0.25f * float(n), openvdb::Vec3f(c, c, c), 1.f, halfWidth);
+  if (whole) grid->clip(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(n - 1)));  // the grid
+  using Tracker = openvdb::tools::LevelSetTracker<openvdb::FloatGrid>;
+  Tracker tracker(*grid);
+  tracker.setSpatialScheme(openvdb::math::FIRST_BIAS);
+  tracker.setTemporalScheme(openvdb::math::TVD_RK1);
+  tracker.setNormCount(1);
+  for (auto _ : state) tracker.normalize();
+  setCounters(state, double(grid->activeVoxelCount()));
+}
+
+void denseArgs(benchmark::internal::Benchmark* b) {
+  for (int n : {64, 128, 256})
+    for (int p : {32, 16}) b->Args({n, p});
+}
+void redistArgs(benchmark::internal::Benchmark* b) {
+  for (int n : {64, 128, 256})
+    for (int p : {32, 16})
+      for (int order : {2, 1}) b->Args({n, p, order});
+}
+void vdbArgs(benchmark::internal::Benchmark* b) {
+  for (int n : {64, 128, 256})
+    for (int whole : {0, 1}) b->Args({n, whole});
+}
+
+BENCHMARK(BM_SdfOpt)
+    ->Apply(denseArgs)
+    ->ArgNames({"n", "fp"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Redist)
+    ->Apply(redistArgs)
+    ->ArgNames({"n", "fp", "order"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_OpenVdbRenormalize)
+    ->Apply(vdbArgs)
+    ->ArgNames({"n", "whole"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

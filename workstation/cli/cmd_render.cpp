@@ -1,9 +1,11 @@
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 #include "cli_common.h"
 #include "commands.h"
 #include "visopt/error.h"
+#include "visopt/session.h"
 
 namespace visopt::cli {
 
@@ -15,14 +17,21 @@ double msSince(std::chrono::steady_clock::time_point t) {
 
 Runner addRenderCommand(CLI::App& app) {
   struct Options {
-    std::string volume, scene, tf, size = "512x512", camera, precision = "fp32", out;
+    std::string volume, scene, session, tf, size = "512x512", camera, precision = "fp32", out;
     int resolution = 128;
     float step = 0.5f;
     bool preview = false, json = false, noJitter = false;
   };
   auto o = std::make_shared<Options>();
-  app.add_option("--volume", o->volume, "Volume file (NIfTI, MetaImage, VTK, NRRD, raw+json) or DICOM folder");
-  app.add_option("--scene", o->scene, "Built-in scene, builtin:NAME (see `visopt scenes`)");
+  CLI::Option* volumeOption = app.add_option(
+      "--volume", o->volume, "Volume file (NIfTI, MetaImage, VTK, NRRD, raw+json) or DICOM folder");
+  CLI::Option* sceneOption =
+      app.add_option("--scene", o->scene, "Built-in scene, builtin:NAME (see `visopt scenes`)");
+  app.add_option("--session", o->session,
+                 "Session file: supplies data, transfer function, view and render settings "
+                 "(options given explicitly override them)")
+      ->excludes(volumeOption)
+      ->excludes(sceneOption);
   app.add_option("--resolution", o->resolution, "Built-in scene resolution (longest axis, voxels)");
   app.add_option("--tf", o->tf, "Transfer function: a JSON file (visopt or ParaView) or preset:NAME");
   app.add_option("--size", o->size, "Image size WxH");
@@ -36,11 +45,35 @@ Runner addRenderCommand(CLI::App& app) {
   app.add_option("--out", o->out, "Output PNG")->required();
   app.add_flag("--json", o->json, "Print per-stage times and the memory ledger as JSON");
 
-  return [o]() {
+  return [o, &app]() {
     resetStageTimings();
     const auto t0 = std::chrono::steady_clock::now();
-    Engine engine(parsePrecision(o->precision));
-    loadInput(engine, o->volume, o->scene, o->resolution, !o->json);
+    auto given = [&app](const char* name) { return app.get_option(name)->count() > 0; };
+    // A session supplies the scene and the render settings; explicit options override them.
+    std::optional<Session> session;
+    if (!o->session.empty()) session = loadSession(o->session);
+    const Precision precision =
+        session && !given("--precision") ? session->precision : parsePrecision(o->precision);
+    Engine engine(precision);
+    nlohmann::json sessionData = nlohmann::json::array();
+    if (session) {
+      const SessionLoadReport report = applySession(engine, *session, o->session);
+      bool missing = !report.sceneLoaded;
+      for (const SessionDataReport& d : report.data) {
+        if (d.status != DataStatus::Ok)
+          std::fprintf(stderr, "visopt: %s: %s\n", o->session.c_str(), describe(d).c_str());
+        missing |= d.status == DataStatus::Missing || d.status == DataStatus::Unreadable;
+        sessionData.push_back(
+            {{"role", d.role}, {"status", toString(d.status)}, {"resolved", d.resolvedPath}});
+      }
+      for (const std::string& w : report.warnings)
+        std::fprintf(stderr, "visopt: %s: %s\n", o->session.c_str(), w.c_str());
+      if (missing)
+        throw Error(ErrorKind::BadInput,
+                    o->session + ": the session's data cannot be found or read (see above)");
+    } else {
+      loadInput(engine, o->volume, o->scene, o->resolution, !o->json);
+    }
     const double loadMs = msSince(t0);
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
     if (!o->camera.empty()) {
@@ -49,13 +82,15 @@ Runner addRenderCommand(CLI::App& app) {
       engine.orbitCamera(c.x, c.y, c.z);
       engine.setLight(PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));
     }
-    RenderSettings settings;
-    glm::ivec2 size = parseSize(o->size);
-    settings.width = size.x;
-    settings.height = size.y;
-    settings.stepFactor = o->step;
-    settings.preview = o->preview;
-    settings.jitter = !o->noJitter;
+    RenderSettings settings = session ? session->render : RenderSettings{};
+    if (!session || given("--size")) {
+      glm::ivec2 size = parseSize(o->size);
+      settings.width = size.x;
+      settings.height = size.y;
+    }
+    if (!session || given("--step")) settings.stepFactor = o->step;
+    if (!session || o->preview) settings.preview = o->preview;
+    if (!session || o->noJitter) settings.jitter = !o->noJitter;
     RenderStats stats;
     Image image = engine.render(settings, &stats);
     const auto tw = std::chrono::steady_clock::now();
@@ -67,7 +102,7 @@ Runner addRenderCommand(CLI::App& app) {
           {"command", "render"},
           {"backend", backendDescription()},
           {"input", engine.volume().sourcePath},
-          {"precision", o->precision},
+          {"precision", toString(precision)},
           {"out", o->out},
           {"image", {{"width", settings.width}, {"height", settings.height},
                      {"rendered_width", stats.width}, {"rendered_height", stats.height}}},
@@ -78,6 +113,7 @@ Runner addRenderCommand(CLI::App& app) {
           {"samples_per_second", stats.milliseconds > 0 ? double(stats.samples) / (stats.milliseconds * 1e-3) : 0.0},
           {"stages", stageTimingsJson()},
           {"memory", ledgerJson(engine.ledger())}};
+      if (session) j["session"] = {{"path", o->session}, {"data", sessionData}};
       std::printf("%s\n", j.dump(2).c_str());
     } else {
       std::printf("wrote %s (%dx%d, %.0f ms render, %s)\n", o->out.c_str(), settings.width,

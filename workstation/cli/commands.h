@@ -15,5 +15,6 @@ Runner addScenesCommand(CLI::App& app);
 Runner addRenderCommand(CLI::App& app);
 Runner addOptimizeCommand(CLI::App& app);
 Runner addSdfCommand(CLI::App& app);
+Runner addSessionInfoCommand(CLI::App& app);
 
 }  // namespace visopt::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   add(addRenderCommand, "render", "Render a volume or built-in scene to a PNG");
   add(addOptimizeCommand, "optimize", "Optimise the extinction so the important parts show");
   add(addSdfCommand, "sdf", "Convert a triangle mesh to a signed distance field (.vdb)");
+  add(addSessionInfoCommand, "session-info", "Describe a session file and check its data files");
 
   try {
     app.parse(argc, argv);

@@ -82,6 +82,8 @@ class Engine {
   // Builds the base SDF phi0 on the volume grid; returns the surface's index. Errors: Usage for a
   // malformed source, BadInput for unreadable files or meshes unfit for a filled SDF.
   int addContextSurface(const ContextSurfaceSpec& spec, const ProgressCallback& progress = {});
+  // A surface given directly as its base SDF on the volume grid (spec.source is descriptive).
+  int addContextSurface(const ContextSurfaceSpec& spec, const Field3D& baseSdf);
   void clearContextSurfaces();
   const std::vector<ContextSurfaceSpec>& contextSurfaces() const;
   void setContextSurfaceVisible(int index, bool visible);

@@ -111,7 +111,7 @@ struct Session {
   std::vector<SessionSurface> contextSurfaces;
   ExtinctionSettings extinction;
   LevelSetSettings levelSet;
-  std::optional<Camera> camera;      // empty: the framing the data source gives
+  std::optional<Camera> camera;  // empty: the framing the data source gives
   std::optional<PointLight> light;
   ImportanceLens lens;
   RenderSettings render;  // image size, deviation view, ... (the engine does not hold them)
@@ -133,6 +133,9 @@ struct SessionDataReport {
   std::string resolvedPath;
   std::string message;  // Unreadable: why
 };
+
+// One line for people: "volume: moved: found at /new/ct.nii.gz through ../data/ct.nii.gz".
+std::string describe(const SessionDataReport& report);
 
 struct SessionLoadReport {
   std::vector<SessionDataReport> data;

@@ -193,8 +193,7 @@ void Engine::setTransferFunction(TransferFunction tf) {
   tf.validate();
   impl_->tf = std::move(tf);
   impl_->hasTf = true;
-  impl_->tableDirty = true;
-  impl_->optimizer.reset();  // mu_bar changed: the optimised mu no longer applies
+  impl_->tableDirty = true;  // mu_bar changes; the optimisation continues from its current mu
 }
 
 const TransferFunction& Engine::transferFunction() const {
@@ -237,6 +236,21 @@ int Engine::addContextSurface(const ContextSurfaceSpec& spec, const ProgressCall
     throw Error(ErrorKind::Usage, "at most 4 context surfaces are supported");
   impl_->surfaceBases.push_back(buildContextSurface(spec, *impl_->volume, impl_->levelSet,
                                                     impl_->precision, &impl_->ledger, progress));
+  impl_->surfaceSpecs.push_back(spec);
+  impl_->optimizer.reset();
+  impl_->lightDirty = true;
+  return int(impl_->surfaceSpecs.size()) - 1;
+}
+
+int Engine::addContextSurface(const ContextSurfaceSpec& spec, const Field3D& baseSdf) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its context surfaces");
+  if (impl_->surfaceBases.size() >= 4)
+    throw Error(ErrorKind::Usage, "at most 4 context surfaces are supported");
+  if (baseSdf.grid().dims != impl_->volume->grid().dims)
+    throw Error(ErrorKind::Usage, "a context surface's SDF must be on the volume's grid");
+  Field3D base("surface-base", impl_->volume->grid(), impl_->precision, &impl_->ledger);
+  for (size_t i = 0; i < base.size(); ++i) base.set(i, baseSdf.get(i));
+  impl_->surfaceBases.push_back(std::move(base));
   impl_->surfaceSpecs.push_back(spec);
   impl_->optimizer.reset();
   impl_->lightDirty = true;
@@ -317,7 +331,7 @@ void Engine::setImportanceCurve(const std::vector<glm::dvec2>& points, const std
   impl_->importance.emplace(importanceFromCurve(*impl_->volume, points, origin, impl_->precision,
                                                 &impl_->ledger));
   impl_->importanceSource = {ImportanceSource::Kind::Curve, points, {}};
-  impl_->optimizer.reset();
+  // The optimisation continues from its current state with the new importance (warm start).
 }
 
 void Engine::loadImportance(const std::string& path) {
@@ -330,7 +344,6 @@ void Engine::loadImportance(const std::string& path) {
   impl_->importance.reset();
   impl_->importance.emplace(std::move(g));
   impl_->importanceSource = {ImportanceSource::Kind::Volume, {}, path};
-  impl_->optimizer.reset();
 }
 
 const Engine::ImportanceSource& Engine::importanceSource() const {

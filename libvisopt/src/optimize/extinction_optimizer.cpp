@@ -146,6 +146,7 @@ struct ExtinctionOptimizer::Level {
   int shrink = 1;  // frustum grids are this many times coarser than at the finest level
   int t = 0;  // optimiser steps taken on this level
   float gradientScale = 1.f;
+  double motionSinceRedistance = 0.0;  // bound on |delta phi| since the last redistancing
   double lastEnergy = 0.0;
 };
 
@@ -459,15 +460,25 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   for (size_t si = 0; si < L.phi.size(); ++si) {
     const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
     ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, in.levelSet, *L.scratch);
+    L.motionSinceRedistance = std::max(L.motionSinceRedistance,
+                                       ls.maxChange * double(std::max(ls.substeps, 1)));
   }
   st.sdfStepMs = msSince(t0);
   st.levelSetTimeStep = ls.timeStep;
 
+  // Redistancing (Eq. 18) runs once the steps since the last one may have moved phi by half a
+  // voxel somewhere. Each redistancing moves the zero level set by a small O(h) amount of its
+  // own (the subcell estimate next to the interface); run after every tiny step it would undo
+  // slow surface motion, which is what happened with a thin shell whose medial kink lies a
+  // voxel from the surface.
   auto t1 = Clock::now();
-  for (auto& phi : L.phi) {
-    RedistanceStats rs = redistance(phi, in.levelSet, *L.scratch);
-    st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
-    st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
+  if (L.motionSinceRedistance >= 0.5 * double(L.grid.minSpacing())) {
+    for (auto& phi : L.phi) {
+      RedistanceStats rs = redistance(phi, in.levelSet, *L.scratch);
+      st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
+      st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
+    }
+    L.motionSinceRedistance = 0.0;
   }
   st.redistanceMs = msSince(t1);
 

@@ -29,11 +29,16 @@ DataReference rebaseDataReference(DataReference ref, const std::string& sessionP
 
 const char* toString(DataStatus status) {
   switch (status) {
-    case DataStatus::Ok: return "ok";
-    case DataStatus::Moved: return "moved";
-    case DataStatus::Changed: return "changed";
-    case DataStatus::Missing: return "missing";
-    case DataStatus::Unreadable: return "unreadable";
+    case DataStatus::Ok:
+      return "ok";
+    case DataStatus::Moved:
+      return "moved";
+    case DataStatus::Changed:
+      return "changed";
+    case DataStatus::Missing:
+      return "missing";
+    case DataStatus::Unreadable:
+      return "unreadable";
   }
   return "?";
 }

@@ -27,8 +27,8 @@ class FieldTable {
   }
 
   // Only the members that differ from S{} (or from `defaults`).
-  nlohmann::json write(const S& value, const S& defaults = S{}) const {
-    nlohmann::json out = nlohmann::json::object();
+  OrderedJson write(const S& value, const S& defaults = S{}) const {
+    OrderedJson out = OrderedJson::object();
     for (const auto& [key, member] : fields_)
       std::visit(
           [&](auto m) {
@@ -39,8 +39,8 @@ class FieldTable {
   }
 
   // Every member (for values whose defaults mean nothing, like a camera).
-  nlohmann::json writeAll(const S& value) const {
-    nlohmann::json out = nlohmann::json::object();
+  OrderedJson writeAll(const S& value) const {
+    OrderedJson out = OrderedJson::object();
     for (const auto& [key, member] : fields_)
       std::visit([&](auto m) { out[key] = toJson(value.*m); }, member);
     return out;

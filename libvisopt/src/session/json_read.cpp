@@ -67,7 +67,7 @@ void readValue(const nlohmann::json& j, glm::dvec2& out, const Where& where) {
   for (int i = 0; i < 2; ++i) readValue(j[size_t(i)], out[i], where.index(size_t(i)));
 }
 
-nlohmann::json toJson(float v) {
+OrderedJson toJson(float v) {
   if (!std::isfinite(v)) return nullptr;  // never written by visopt; reads back as an error
   char buf[32];
   const auto res = std::to_chars(buf, buf + sizeof(buf), v);
@@ -76,6 +76,8 @@ nlohmann::json toJson(float v) {
   return d;
 }
 
-nlohmann::json toJson(const glm::vec3& v) { return {toJson(v.x), toJson(v.y), toJson(v.z)}; }
+OrderedJson toJson(const glm::vec3& v) {
+  return {toJson(v.x), toJson(v.y), toJson(v.z)};
+}
 
 }  // namespace visopt::session

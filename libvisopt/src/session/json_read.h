@@ -13,7 +13,9 @@ namespace visopt::session {
 // Where a value sits: the file and the key path inside it.
 struct Where {
   std::string origin, path;
-  Where key(const std::string& name) const { return {origin, path.empty() ? name : path + "." + name}; }
+  Where key(const std::string& name) const {
+    return {origin, path.empty() ? name : path + "." + name};
+  }
   Where index(size_t i) const { return {origin, path + "[" + std::to_string(i) + "]"}; }
   [[noreturn]] void fail(const std::string& problem) const;
 };
@@ -45,10 +47,18 @@ void readOptional(const nlohmann::json& j, const char* key, T& out, const Where&
 
 // Floats are written as the shortest decimal that reads back to the same float (0.05, not
 // 0.05000000074505806), so files stay readable and round trips stay exact.
-nlohmann::json toJson(float v);
-inline nlohmann::json toJson(int v) { return v; }
-inline nlohmann::json toJson(uint32_t v) { return v; }
-inline nlohmann::json toJson(bool v) { return v; }
-nlohmann::json toJson(const glm::vec3& v);
+// Written documents keep their keys in insertion order ("format" and "version" first).
+using OrderedJson = nlohmann::ordered_json;
+OrderedJson toJson(float v);
+inline OrderedJson toJson(int v) {
+  return v;
+}
+inline OrderedJson toJson(uint32_t v) {
+  return v;
+}
+inline OrderedJson toJson(bool v) {
+  return v;
+}
+OrderedJson toJson(const glm::vec3& v);
 
 }  // namespace visopt::session

@@ -29,8 +29,8 @@ std::vector<uint8_t> decodeMaskBits(const std::string& text, size_t expectedByte
   if (size == ZSTD_CONTENTSIZE_ERROR)
     throwBadInput(origin, "the world mask's data is not a zstd frame");
   if (size != ZSTD_CONTENTSIZE_UNKNOWN && size != expectedBytes)
-    throwBadInput(origin, "the world mask holds " + std::to_string(size) + " bytes, its dims need " +
-                              std::to_string(expectedBytes));
+    throwBadInput(origin, "the world mask holds " + std::to_string(size) +
+                              " bytes, its dims need " + std::to_string(expectedBytes));
   std::vector<uint8_t> bits(expectedBytes);
   const size_t n = ZSTD_decompress(bits.data(), bits.size(), packed->data(), packed->size());
   if (ZSTD_isError(n))

@@ -14,7 +14,9 @@ namespace visopt {
 
 namespace {
 
-std::string surfaceRole(size_t index) { return "context surface " + std::to_string(index + 1); }
+std::string surfaceRole(size_t index) {
+  return "context surface " + std::to_string(index + 1);
+}
 
 SessionDataReport check(const std::string& role, const DataReference& ref,
                         const std::string& sessionPath) {
@@ -129,7 +131,8 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
 
   stages.at(0.6f, "session: transfer function and importance");
   if (session.transferFunction)
-    warnIfFails("transfer function", [&] { engine.setTransferFunction(*session.transferFunction); });
+    warnIfFails("transfer function",
+                [&] { engine.setTransferFunction(*session.transferFunction); });
   switch (session.importance.kind) {
     case SessionImportance::Kind::None:
     case SessionImportance::Kind::Scene:  // loaded with the built-in scene
@@ -141,8 +144,7 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
       break;
     case SessionImportance::Kind::Volume: {
       SessionDataReport d = check("importance", session.importance.volume, sessionPath);
-      if (usable(d, options) &&
-          !attempt([&] { engine.loadImportance(d.resolvedPath); }, d.message))
+      if (usable(d, options) && !attempt([&] { engine.loadImportance(d.resolvedPath); }, d.message))
         d.status = DataStatus::Unreadable;
       report.data.push_back(d);
       break;

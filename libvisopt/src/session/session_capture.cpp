@@ -28,7 +28,8 @@ Session captureSession(const Engine& engine, const RenderSettings& render,
 
   const Engine::ImportanceSource& imp = engine.importanceSource();
   switch (imp.kind) {
-    case Engine::ImportanceSource::Kind::None: break;
+    case Engine::ImportanceSource::Kind::None:
+      break;
     case Engine::ImportanceSource::Kind::Scene:
       s.importance.kind = SessionImportance::Kind::Scene;
       break;

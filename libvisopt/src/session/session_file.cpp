@@ -2,6 +2,7 @@
 // which is fsynced and renamed over the target (and the folder fsynced), so a crash at any point
 // leaves either the old file or the new one, never a mix.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -37,8 +38,8 @@ void reachStage(const char* stage) {
 }
 
 [[noreturn]] void failWrite(const std::string& path, const std::string& what, int err) {
-  throw Error(ErrorKind::Failure, path + ": cannot save the session: " + what + ": " +
-                                      std::strerror(err));
+  throw Error(ErrorKind::Failure,
+              path + ": cannot save the session: " + what + ": " + std::strerror(err));
 }
 
 void writeAll(int fd, const char* data, size_t size, const std::string& path) {
@@ -66,7 +67,9 @@ struct Temporary {
 
 }  // namespace
 
-void setSessionSaveHook(SessionSaveHook hook) { saveHook.store(hook); }
+void setSessionSaveHook(SessionSaveHook hook) {
+  saveHook.store(hook);
+}
 
 void saveSession(const Session& session, const std::string& path) {
   const fs::path target = fs::absolute(fs::path(path));
@@ -77,13 +80,18 @@ void saveSession(const Session& session, const std::string& path) {
   const std::string text = sessionToJson(session, target.string());
 
   Temporary tmp;
-  std::string pattern = (dir / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  std::string hidden = target.filename().string();
+  hidden.insert(hidden.begin(), '.');
+  hidden.append(".tmp-XXXXXX");
+  std::string pattern = (dir / hidden).string();
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   tmp.fd = ::mkstemp(name.data());
   if (tmp.fd < 0) failWrite(path, "cannot create a temporary file next to it", errno);
   tmp.path = name.data();
-  ::fchmod(tmp.fd, 0644);
+  // Keep the permissions of the file being replaced; a new one gets rw-r--r--.
+  struct stat old {};
+  ::fchmod(tmp.fd, ::stat(target.c_str(), &old) == 0 ? (old.st_mode & 07777) : 0644);
   reachStage("temporary-open");
 
   const size_t half = text.size() / 2;

@@ -6,7 +6,8 @@
 //    "contextSurfaces": [{"source": "mesh:...", "file": REF, ...}], "extinction": {...},
 //    "levelSet": {...}, "camera": {...}, "light": {...}, "lens": {...}, "render": {...},
 //    "frozen": true, "worldMask": {"dims": [..], "encoding": "bits-lsb+zstd+base64", ...}}
-//   REF = {"absolute": "/data/ct.nii.gz", "relative": "../data/ct.nii.gz", "sha256": .., "bytes": ..}
+//   REF = {"absolute": "/data/ct.nii.gz", "relative": "../data/ct.nii.gz", "sha256": .., "bytes":
+//   ..}
 // Settings sections hold only values that differ from the defaults and are left out when empty.
 #include <nlohmann/json.hpp>
 
@@ -20,6 +21,7 @@
 namespace visopt {
 
 using nlohmann::json;
+using session::OrderedJson;
 using session::Where;
 
 namespace {
@@ -27,8 +29,8 @@ namespace {
 constexpr const char* kFormat = "visopt-session";
 constexpr const char* kMaskEncoding = "bits-lsb+zstd+base64";
 
-json referenceToJson(const DataReference& ref) {
-  json j = json::object();
+OrderedJson referenceToJson(const DataReference& ref) {
+  OrderedJson j = OrderedJson::object();
   if (!ref.absolutePath.empty()) j["absolute"] = ref.absolutePath;
   if (!ref.relativePath.empty()) j["relative"] = ref.relativePath;
   if (!ref.sha256.empty()) j["sha256"] = ref.sha256;
@@ -52,19 +54,23 @@ DataReference referenceFromJson(const json& j, const Where& where) {
 
 const char* importanceKindName(SessionImportance::Kind kind) {
   switch (kind) {
-    case SessionImportance::Kind::Scene: return "scene";
-    case SessionImportance::Kind::Curve: return "curve";
-    case SessionImportance::Kind::Volume: return "volume";
-    case SessionImportance::Kind::None: break;
+    case SessionImportance::Kind::Scene:
+      return "scene";
+    case SessionImportance::Kind::Curve:
+      return "curve";
+    case SessionImportance::Kind::Volume:
+      return "volume";
+    case SessionImportance::Kind::None:
+      break;
   }
   return "none";
 }
 
-void putIfNotEmpty(json& doc, const char* key, json value) {
+void putIfNotEmpty(OrderedJson& doc, const char* key, OrderedJson value) {
   if (!value.empty()) doc[key] = std::move(value);
 }
 
-json maskToJson(const SessionMask& m) {
+OrderedJson maskToJson(const SessionMask& m) {
   size_t set = 0;
   for (uint8_t b : m.bits) set += size_t(__builtin_popcount(b));
   return {{"dims", {m.dims.x, m.dims.y, m.dims.z}},
@@ -88,8 +94,8 @@ SessionMask maskFromJson(const json& j, const Where& where) {
   if (encoding != kMaskEncoding)
     where.key("encoding").fail("unknown encoding \"" + encoding + "\"");
   session::readRequired(j, "data", data, where);
-  m.bits = session::decodeMaskBits(data, (m.voxelCount() + 7) / 8,
-                                   where.origin + ": " + where.path);
+  m.bits =
+      session::decodeMaskBits(data, (m.voxelCount() + 7) / 8, where.origin + ": " + where.path);
   if (auto it = j.find("voxelsSet"); it != j.end()) {
     size_t set = 0;
     for (uint8_t b : m.bits) set += size_t(__builtin_popcount(b));
@@ -210,17 +216,18 @@ std::string oneLine(std::string text) {
 }  // namespace
 
 std::string sessionToJson(const Session& s, const std::string& sessionPath) {
-  json doc = {{"format", kFormat}, {"version", kSessionFormatVersion}};
+  OrderedJson doc = {{"format", kFormat}, {"version", kSessionFormatVersion}};
   if (!s.builtinScene.empty())
     doc["data"] = {{"builtin", s.builtinScene}, {"resolution", s.builtinResolution}};
   else
     doc["data"] = {{"volume", referenceToJson(rebaseDataReference(s.volume, sessionPath))}};
   if (s.precision != Precision::FP32) doc["precision"] = toString(s.precision);
-  if (s.transferFunction) doc["transferFunction"] = json::parse(s.transferFunction->toJson());
+  if (s.transferFunction)
+    doc["transferFunction"] = OrderedJson::parse(s.transferFunction->toJson());
   if (s.importance.kind != SessionImportance::Kind::None) {
-    json imp = {{"kind", importanceKindName(s.importance.kind)}};
+    OrderedJson imp = {{"kind", importanceKindName(s.importance.kind)}};
     if (s.importance.kind == SessionImportance::Kind::Curve) {
-      json points = json::array();
+      OrderedJson points = OrderedJson::array();
       for (const auto& p : s.importance.curve) points.push_back({p.x, p.y});
       imp["points"] = std::move(points);
     } else if (s.importance.kind == SessionImportance::Kind::Volume) {
@@ -229,9 +236,9 @@ std::string sessionToJson(const Session& s, const std::string& sessionPath) {
     doc["importance"] = std::move(imp);
   }
   if (!s.contextSurfaces.empty()) {
-    json list = json::array();
+    OrderedJson list = OrderedJson::array();
     for (const SessionSurface& surface : s.contextSurfaces) {
-      json sj = {{"source", surface.spec.source}};
+      OrderedJson sj = {{"source", surface.spec.source}};
       sj.update(session::surfaceFields().write(surface.spec));
       if (!surface.file.empty())
         sj["file"] = referenceToJson(rebaseDataReference(surface.file, sessionPath));
@@ -240,7 +247,7 @@ std::string sessionToJson(const Session& s, const std::string& sessionPath) {
     doc["contextSurfaces"] = std::move(list);
   }
   {
-    json ext = session::extinctionFields().write(s.extinction);
+    OrderedJson ext = session::extinctionFields().write(s.extinction);
     if (s.extinction.optimizer != ExtinctionSettings{}.optimizer)
       ext["optimizer"] = toString(s.extinction.optimizer);
     putIfNotEmpty(doc, "extinction", std::move(ext));
@@ -261,7 +268,8 @@ Session sessionFromJson(const std::string& text, const std::string& origin) {
     doc = json::parse(text);
   } catch (const json::parse_error& e) {
     std::string msg = e.what();
-    if (auto close = msg.find("] "); !msg.empty() && msg.front() == '[' && close != std::string::npos)
+    if (auto close = msg.find("] ");
+        !msg.empty() && msg.front() == '[' && close != std::string::npos)
       msg = msg.substr(close + 2);
     throwBadInput(origin, "not a session file: invalid JSON (" + oneLine(msg) + ")");
   }

@@ -22,7 +22,8 @@ void cameraOrbitToFrame(nlohmann::json& doc, const Where& where) {
   readRequired(*it, "distance", distance, w);
   if (!(distance > 0.f)) w.key("distance").fail("must be positive");
   const Camera c = Camera::orbit(target, azimuth, elevation, distance);
-  nlohmann::json frame = {{"eye", toJson(c.eye)}, {"target", toJson(c.target)}, {"up", toJson(c.up)}};
+  auto vec = [](glm::vec3 v) { return nlohmann::json{v.x, v.y, v.z}; };
+  nlohmann::json frame = {{"eye", vec(c.eye)}, {"target", vec(c.target)}, {"up", vec(c.up)}};
   if (it->contains("fovY")) frame["fovY"] = (*it)["fovY"];
   *it = std::move(frame);
 }

@@ -3,6 +3,8 @@
 // A format change adds one converter and bumps kSessionFormatVersion; no converter is ever edited.
 #pragma once
 
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "session/json_read.h"

@@ -1,0 +1,521 @@
+// Sessions never lose work: exact round trips (JSON and rendered image), migration of older
+// versions, clear errors for damaged files, data found after a move and reported when missing,
+// the world mask stored exactly, atomic saves that survive a crash mid-save, and the CLI.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "session/base64.h"
+#include "session/sha256.h"
+#include "visopt/engine.h"
+#include "visopt/error.h"
+#include "visopt/session.h"
+
+namespace fs = std::filesystem;
+using namespace visopt;
+
+namespace {
+
+fs::path freshDir(const std::string& name) {
+  const fs::path dir = fs::path(VISOPT_TEST_TMP) / "session" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string readText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void writeText(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << text;
+}
+
+// A float32 raw volume with its JSON sidecar: a smooth blob, anisotropic dims.
+void writeRawVolume(const fs::path& raw, glm::ivec3 dims, float scale = 1.f) {
+  std::vector<float> v(size_t(dims.x) * size_t(dims.y) * size_t(dims.z));
+  size_t i = 0;
+  for (int k = 0; k < dims.z; ++k)
+    for (int j = 0; j < dims.y; ++j)
+      for (int x = 0; x < dims.x; ++x) {
+        const glm::vec3 p = (glm::vec3(x, j, k) + 0.5f) / glm::vec3(dims) - 0.5f;
+        v[i++] = scale * std::max(0.f, 1.f - 2.5f * glm::length(p));
+      }
+  std::ofstream(raw, std::ios::binary)
+      .write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(float)));
+  writeText(raw.string() + ".json", "{\"dims\":[" + std::to_string(dims.x) + "," +
+                                        std::to_string(dims.y) + "," + std::to_string(dims.z) +
+                                        "],\"type\":\"float32\",\"spacing\":[1,1.5,2]}");
+}
+
+RenderSettings smallRender() {
+  RenderSettings r;
+  r.width = 40;
+  r.height = 32;
+  r.seed = 7;
+  r.lightGridSize = 32;
+  return r;
+}
+
+void expectSameImage(const Image& a, const Image& b) {
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+  size_t differing = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) differing += a.pixels[i] != b.pixels[i];
+  EXPECT_EQ(differing, 0u) << "PSNR " << psnr(a, b);
+}
+
+// Runs `f`, expecting Error(BadInput) with a one-line message that starts with `file`.
+template <class F>
+std::string expectBadInput(F&& f, const std::string& file) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::BadInput) << e.what();
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(file + ": ", 0), 0u) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    return msg;
+  }
+  ADD_FAILURE() << "no error for " << file;
+  return {};
+}
+
+// An engine with a built-in scene and every kind of setting changed from its default.
+void setUpRichScene(Engine& engine) {
+  engine.loadBuiltinScene("marschner-lobb", 24);
+  ExtinctionSettings ext;
+  ext.q = 12.5f;
+  ext.optimizer = OptimizerKind::Adam;
+  ext.levels = 2;
+  engine.setExtinctionSettings(ext);
+  LevelSetSettings ls;
+  ls.lambda = 0.45f;
+  ls.substeps = 3;
+  engine.setLevelSetSettings(ls);
+  engine.orbitCamera(33.f, 21.f, 2.7f);
+  PointLight light = engine.light();
+  light.intensity = 1.7f;
+  light.color = {1.f, 0.9f, 0.8f};
+  engine.setLight(light);
+  engine.setLens({0.4f, 0.6f, 0.2f, 0.f});
+  TransferFunction tf = engine.transferFunction();
+  tf.name = "edited";
+  tf.opacity.back().opacity = 0.61f;
+  engine.setTransferFunction(tf);
+  const GridSpec& g = engine.volume().grid();
+  Field3D mask("mask", g, Precision::FP32);
+  std::mt19937 rng(5);
+  for (size_t i = 0; i < mask.size(); ++i) mask.set(i, float(rng() & 1u));
+  engine.setWorldMask(std::move(mask));
+  engine.setFrozen(true);
+}
+
+struct CliResult {
+  int code = -1;
+  std::string out, err;
+};
+
+CliResult runCli(const std::string& args) {
+  const fs::path dir = fs::path(VISOPT_TEST_TMP) / "session";
+  fs::create_directories(dir);
+  const std::string errFile = (dir / "cli-stderr.txt").string();
+  FILE* pipe = popen((std::string(VISOPT_CLI) + " " + args + " 2>" + errFile).c_str(), "r");
+  CliResult r;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.err = readText(errFile);
+  return r;
+}
+
+}  // namespace
+
+TEST(Sha256, KnownVectors) {
+  using session::sha256Hex;
+  EXPECT_EQ(sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  // One million 'a' fed in uneven pieces exercises the block buffering.
+  session::Sha256 h;
+  const std::string chunk(997, 'a');
+  size_t fed = 0;
+  while (fed < 1000000) {
+    const size_t n = std::min(chunk.size() - fed % 7, 1000000 - fed);
+    h.update(chunk.data(), n);
+    fed += n;
+  }
+  EXPECT_EQ(h.hexDigest(), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(Sha256, DataReferenceHashesFilesAndFolders) {
+  const fs::path dir = freshDir("hash");
+  writeText(dir / "a.bin", "abc");
+  const DataReference ref = makeDataReference((dir / "a.bin").string(), (dir / "s.json").string());
+  EXPECT_EQ(ref.sha256, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(ref.bytes, 3u);
+  EXPECT_EQ(ref.relativePath, "a.bin");
+  EXPECT_TRUE(fs::path(ref.absolutePath).is_absolute());
+  // A folder (a DICOM series): names and contents in name order; renaming a file changes it.
+  fs::create_directories(dir / "series");
+  writeText(dir / "series" / "2.dcm", "second");
+  writeText(dir / "series" / "1.dcm", "first");
+  const DataReference folder = makeDataReference((dir / "series").string(), {});
+  EXPECT_EQ(folder.bytes, 11u);
+  EXPECT_EQ(folder.sha256.size(), 64u);
+  fs::rename(dir / "series" / "2.dcm", dir / "series" / "3.dcm");
+  EXPECT_NE(makeDataReference((dir / "series").string(), {}).sha256, folder.sha256);
+}
+
+TEST(Session, Base64RoundTripsAndRejectsGarbage) {
+  for (size_t n = 0; n < 8; ++n) {
+    std::vector<uint8_t> bytes;
+    for (size_t i = 0; i < n; ++i) bytes.push_back(uint8_t(251 * i + 3));
+    EXPECT_EQ(session::base64Decode(session::base64Encode(bytes)), bytes);
+  }
+  EXPECT_EQ(session::base64Encode({'f', 'o', 'o', 'b'}), "Zm9vYg==");
+  EXPECT_FALSE(session::base64Decode("Zm9vYg="));
+  EXPECT_FALSE(session::base64Decode("Zm9v!g=="));
+  EXPECT_FALSE(session::base64Decode("Zm=vYg=="));
+}
+
+TEST(Session, DefaultsAreNotWritten) {
+  Engine engine;
+  engine.loadBuiltinScene("marschner-lobb", 16);
+  const auto doc = nlohmann::json::parse(sessionToJson(captureSession(engine)));
+  EXPECT_EQ(doc["format"], "visopt-session");
+  EXPECT_EQ(doc["version"], kSessionFormatVersion);
+  EXPECT_EQ(doc["data"]["builtin"], "marschner-lobb");
+  EXPECT_EQ(doc["data"]["resolution"], 16);
+  for (const char* key : {"extinction", "levelSet", "lens", "render", "frozen", "worldMask",
+                          "precision", "contextSurfaces"})
+    EXPECT_FALSE(doc.contains(key)) << key;
+  EXPECT_TRUE(doc.contains("camera"));
+}
+
+TEST(Session, SaveLoadGivesTheSameSessionAndTheSameImage) {
+  const fs::path dir = freshDir("roundtrip");
+  const std::string path = (dir / "scene.visopt-session").string();
+  Engine engine;
+  setUpRichScene(engine);
+  RenderSettings render = smallRender();
+  render.deviationView = true;
+  render.exposure = 1.25f;
+  const Session saved = captureSession(engine, render);
+  saveSession(saved, path);
+
+  const Session loaded = loadSession(path);
+  EXPECT_EQ(sessionToJson(loaded, path), sessionToJson(saved, path));
+  EXPECT_EQ(readText(path), sessionToJson(saved, path));
+  ASSERT_TRUE(loaded.worldMask);
+  EXPECT_EQ(*loaded.worldMask, *saved.worldMask);
+  EXPECT_EQ(loaded.extinction.optimizer, OptimizerKind::Adam);
+  EXPECT_EQ(loaded.render.exposure, 1.25f);
+  EXPECT_TRUE(loaded.frozen);
+
+  Engine restored;
+  const SessionLoadReport report = applySession(restored, loaded, path);
+  EXPECT_TRUE(report.sceneLoaded);
+  EXPECT_TRUE(report.allDataFound());
+  EXPECT_TRUE(report.warnings.empty()) << report.warnings.front();
+  EXPECT_TRUE(restored.frozen());
+  EXPECT_EQ(restored.transferFunction().name, "edited");
+  // Capturing the restored engine gives the same session again.
+  EXPECT_EQ(sessionToJson(captureSession(restored, loaded.render), path),
+            sessionToJson(saved, path));
+  expectSameImage(engine.render(render), restored.render(loaded.render));
+}
+
+TEST(Session, WorldMaskRoundTripsExactlyOnAnisotropicDims) {
+  const fs::path dir = freshDir("mask");
+  const fs::path raw = dir / "blob.raw";
+  writeRawVolume(raw, {13, 7, 5});
+  Engine engine;
+  engine.loadVolume(raw.string());
+  Field3D mask("mask", engine.volume().grid(), Precision::FP32);
+  std::mt19937 rng(11);
+  for (size_t i = 0; i < mask.size(); ++i) mask.set(i, float(rng() % 3 == 0));
+  engine.setWorldMask(std::move(mask));
+  const std::string path = (dir / "s.json").string();
+  saveSession(captureSession(engine, {}, path), path);
+
+  Engine restored;
+  const SessionLoadReport report = applySession(restored, loadSession(path), path);
+  ASSERT_TRUE(report.sceneLoaded);
+  ASSERT_NE(restored.worldMask(), nullptr);
+  const Field3D& a = *engine.worldMask();
+  const Field3D& b = *restored.worldMask();
+  ASSERT_EQ(b.grid().dims, glm::ivec3(13, 7, 5));
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a.get(i), b.get(i)) << "voxel " << i;
+  EXPECT_EQ(nlohmann::json::parse(readText(path))["worldMask"]["dims"], nlohmann::json({13, 7, 5}));
+}
+
+// Version 1 stored the camera as an orbit and called two sections "tf" and "surfaces"; version 2
+// stored the camera as a frame. Both load through the converter chain.
+TEST(Session, OlderVersionsLoadThroughTheMigrations) {
+  const std::string tf =
+      R"({"format":"visopt-transfer-function","version":1,"name":"old","unitDistance":0,)"
+      R"("opacity":[[0,0],[1,0.5]],"color":[[0,1,1,1],[1,1,0,0]]})";
+  const std::string v1 =
+      R"({"format":"visopt-session","version":1,"data":{"builtin":"marschner-lobb","resolution":16},)"
+      R"("tf":)" +
+      tf +
+      R"(,"camera":{"target":[0,0,0],"azimuth":90,"elevation":0,"distance":5,"fovY":25},)"
+      R"("surfaces":[{"source":"iso:0.5","filled":false,"shell":0.1}],"extinction":{"q":10}})";
+  const Session s1 = sessionFromJson(v1, "v1.json");
+  EXPECT_EQ(s1.version, 1);
+  ASSERT_TRUE(s1.camera);
+  const Camera expected = Camera::orbit(glm::vec3(0.f), 90.f, 0.f, 5.f);
+  EXPECT_NEAR(glm::length(s1.camera->eye - expected.eye), 0.f, 1e-5f);
+  EXPECT_EQ(s1.camera->fovYDegrees, 25.f);
+  ASSERT_TRUE(s1.transferFunction);
+  EXPECT_EQ(s1.transferFunction->name, "old");
+  ASSERT_EQ(s1.contextSurfaces.size(), 1u);
+  EXPECT_EQ(s1.contextSurfaces[0].spec.source, "iso:0.5");
+  EXPECT_FALSE(s1.contextSurfaces[0].spec.filled);
+  EXPECT_EQ(s1.extinction.q, 10.f);
+  const auto written = nlohmann::json::parse(sessionToJson(s1));
+  EXPECT_EQ(written["version"], kSessionFormatVersion);
+  EXPECT_TRUE(written.contains("transferFunction"));
+  EXPECT_FALSE(written.contains("tf"));
+
+  const std::string v2 =
+      R"({"format":"visopt-session","version":2,"data":{"builtin":"marschner-lobb","resolution":16},)"
+      R"("tf":)" +
+      tf + R"(,"camera":{"eye":[0,-4,1],"target":[0,0,0],"up":[0,0,1]}})";
+  const Session s2 = sessionFromJson(v2, "v2.json");
+  EXPECT_EQ(s2.camera->eye, glm::vec3(0.f, -4.f, 1.f));
+  EXPECT_EQ(s2.transferFunction->name, "old");
+
+  // The migrated session applies.
+  Engine engine;
+  const SessionLoadReport report = applySession(engine, s1, {});
+  EXPECT_TRUE(report.sceneLoaded);
+  for (const auto& w : report.warnings) ADD_FAILURE() << w;
+  EXPECT_EQ(engine.contextSurfaces().size(), 1u);
+  EXPECT_EQ(engine.camera().fovYDegrees, 25.f);
+}
+
+TEST(Session, DamagedFilesGiveOneLineBadInputAndLeaveTheEngineUsable) {
+  const fs::path dir = freshDir("damaged");
+  Engine engine;
+  engine.loadBuiltinScene("marschner-lobb", 16);
+  engine.setWorldMask([&] {
+    Field3D m("m", engine.volume().grid(), Precision::FP32);
+    m.fill(1.f);
+    return m;
+  }());
+  const std::string good = sessionToJson(captureSession(engine));
+
+  auto check = [&](const std::string& name, const std::string& text, const char* needle) {
+    const std::string path = (dir / name).string();
+    writeText(path, text);
+    const std::string msg = expectBadInput([&] { loadSession(path); }, path);
+    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+  };
+  check("truncated.json", good.substr(0, good.size() / 2), "invalid JSON");
+  check("text.json", "hello, world", "invalid JSON");
+  check("array.json", "[1, 2]", "expected a JSON object");
+  check("foreign.json", R"({"format":"something-else","version":1})", "not a session file");
+  check("newer.json", R"({"format":"visopt-session","version":99,"data":{"builtin":"x"}})",
+        "newer than this visopt");
+  check("nodata.json", R"({"format":"visopt-session","version":3})", "missing \"data\"");
+  check("badtype.json",
+        R"({"format":"visopt-session","version":3,"data":{"builtin":"a"},"extinction":{"q":"x"}})",
+        "extinction.q: expected a number");
+  std::string corrupt = good;
+  const auto at = corrupt.find("\"data\": \"") + 12;
+  corrupt[at] = corrupt[at] == 'A' ? 'B' : 'A';
+  check("mask.json", corrupt, "worldMask");
+  check("empty.json", "", "file is empty");
+  expectBadInput([&] { loadSession((dir / "none.json").string()); }, (dir / "none.json").string());
+  // The engine was never touched.
+  EXPECT_EQ(engine.render(smallRender()).width, 40);
+}
+
+TEST(Session, MovedDataIsFoundThroughTheRelativePath) {
+  const fs::path root = freshDir("moved");
+  const fs::path a = root / "a", b = root / "b";
+  fs::create_directories(a / "data");
+  fs::create_directories(a / "sessions");
+  writeRawVolume(a / "data" / "vol.raw", {9, 8, 6}, 100.f);
+  writeRawVolume(a / "data" / "imp.raw", {9, 8, 6}, 1.f);
+  Engine engine;
+  engine.loadVolume((a / "data" / "vol.raw").string());
+  engine.loadImportance((a / "data" / "imp.raw").string());
+  const std::string path = (a / "sessions" / "s.json").string();
+  saveSession(captureSession(engine, smallRender(), path), path);
+  const auto doc = nlohmann::json::parse(readText(path));
+  EXPECT_EQ(doc["data"]["volume"]["relative"], "../data/vol.raw");
+  fs::rename(a, b);
+
+  const std::string moved = (b / "sessions" / "s.json").string();
+  Engine restored;
+  const SessionLoadReport report = applySession(restored, loadSession(moved), moved);
+  ASSERT_TRUE(report.sceneLoaded);
+  ASSERT_EQ(report.data.size(), 2u);
+  for (const auto& d : report.data) {
+    EXPECT_EQ(d.status, DataStatus::Moved) << describe(d);
+    EXPECT_EQ(fs::path(d.resolvedPath).parent_path(), b / "data");
+  }
+  EXPECT_EQ(restored.importanceSource().kind, Engine::ImportanceSource::Kind::Volume);
+  expectSameImage(engine.render(smallRender()), restored.render(smallRender()));
+}
+
+TEST(Session, MissingAndChangedDataAreReportedNotThrown) {
+  const fs::path dir = freshDir("missing");
+  const fs::path raw = dir / "vol.raw";
+  writeRawVolume(raw, {8, 8, 8});
+  Engine engine;
+  engine.loadVolume(raw.string());
+  const std::string path = (dir / "s.json").string();
+  Session s = captureSession(engine, {}, path);
+  saveSession(s, path);
+
+  // Changed: same place, other content; used, and reported.
+  writeRawVolume(raw, {8, 8, 8}, 2.f);
+  {
+    Engine e;
+    const SessionLoadReport r = applySession(e, loadSession(path), path);
+    EXPECT_TRUE(r.sceneLoaded);
+    ASSERT_EQ(r.data.size(), 1u);
+    EXPECT_EQ(r.data[0].status, DataStatus::Changed);
+    EXPECT_FALSE(r.allDataFound());
+    Engine refuse;
+    EXPECT_FALSE(applySession(refuse, loadSession(path), path, {}, {false}).sceneLoaded);
+  }
+
+  // Missing: reported; the engine keeps the scene it had.
+  fs::rename(raw, dir / "elsewhere.raw");
+  fs::rename(dir / "vol.raw.json", dir / "elsewhere.raw.json");
+  Engine e;
+  e.loadBuiltinScene("marschner-lobb", 12);
+  Session loaded = loadSession(path);
+  const SessionLoadReport r = applySession(e, loaded, path);
+  EXPECT_FALSE(r.sceneLoaded);
+  ASSERT_EQ(r.data.size(), 1u);
+  EXPECT_EQ(r.data[0].status, DataStatus::Missing);
+  EXPECT_NE(describe(r.data[0]).find("vol.raw"), std::string::npos);
+  EXPECT_EQ(e.volume().sourcePath, "builtin:marschner-lobb");
+  EXPECT_EQ(checkSessionData(loaded, path)[0].status, DataStatus::Missing);
+
+  // The user points to the file: it loads (its content is the changed one).
+  relocate(loaded, "volume", (dir / "elsewhere.raw").string());
+  const SessionLoadReport again = applySession(e, loaded, path);
+  EXPECT_TRUE(again.sceneLoaded);
+  EXPECT_EQ(again.data[0].status, DataStatus::Changed);
+  EXPECT_THROW(relocate(loaded, "importance", "x"), Error);
+}
+
+TEST(Session, CrashMidSaveLeavesThePreviousFileIntact) {
+  const fs::path dir = freshDir("crash");
+  const std::string path = (dir / "s.json").string();
+  Engine engine;
+  engine.loadBuiltinScene("marschner-lobb", 12);
+  const Session first = captureSession(engine);
+  saveSession(first, path);
+  const std::string before = readText(path);
+  engine.orbitCamera(120.f, 40.f, 4.f);
+  const Session second = captureSession(engine);
+
+  for (const char* stage : {"temporary-open", "mid-write", "after-write"}) {
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      setenv("VISOPT_SESSION_FAULT", stage, 1);
+      try {
+        saveSession(second, path);
+      } catch (...) {
+      }
+      _exit(0);  // not reached when the fault fires
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 70) << stage;
+    EXPECT_EQ(readText(path), before) << stage;
+    EXPECT_EQ(sessionToJson(loadSession(path)), sessionToJson(first)) << stage;
+  }
+
+  // A failure reported by the hook (an exception) leaves no temporary behind.
+  setSessionSaveHook([](const char* stage) {
+    if (std::string(stage) == "mid-write") throw Error(ErrorKind::Failure, "disk full");
+  });
+  EXPECT_THROW(saveSession(second, path), Error);
+  setSessionSaveHook(nullptr);
+  EXPECT_EQ(readText(path), before);
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp-") != std::string::npos)
+      fs::remove(entry.path());  // the crashes' leftovers
+  }
+  saveSession(second, path);
+  EXPECT_EQ(sessionToJson(loadSession(path)), sessionToJson(second));
+}
+
+TEST(Session, CliRendersASessionAndDescribesIt) {
+  const fs::path dir = freshDir("cli");
+  const std::string path = (dir / "s.json").string();
+  Engine engine;
+  engine.loadBuiltinScene("marschner-lobb", 16);
+  RenderSettings render = smallRender();
+  saveSession(captureSession(engine, render), path);
+  const std::string png = (dir / "out.png").string();
+
+  CliResult r = runCli("render --session " + path + " --out " + png + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["image"]["width"], 40);  // from the session
+  EXPECT_EQ(j["image"]["height"], 32);
+  expectSameImage(readPng(png), [&] {
+    Image img = engine.render(render);
+    writePng(img, (dir / "direct.png").string());
+    return readPng((dir / "direct.png").string());
+  }());
+
+  r = runCli("render --session " + path + " --size 20x10 --out " + png + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["image"]["width"], 20);  // explicit options override
+
+  EXPECT_EQ(
+      runCli("render --session " + path + " --scene builtin:marschner-lobb --out " + png).code, 1);
+
+  r = runCli("session-info " + path + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);  // exactly one JSON object
+  EXPECT_EQ(j["file_version"], kSessionFormatVersion);
+  EXPECT_EQ(j["source"], "builtin:marschner-lobb at 16");
+
+  // A session whose volume is gone: reported on stderr, exit 2.
+  const fs::path raw = dir / "vol.raw";
+  writeRawVolume(raw, {8, 8, 8});
+  Engine e;
+  e.loadVolume(raw.string());
+  const std::string gone = (dir / "gone.json").string();
+  saveSession(captureSession(e, render, gone), gone);
+  fs::remove(raw);
+  r = runCli("render --session " + gone + " --out " + png);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("volume: missing"), std::string::npos) << r.err;
+  r = runCli("session-info " + gone + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["data"][0]["status"], "missing");
+  writeText(dir / "bad.json", "{");
+  EXPECT_EQ(runCli("session-info " + (dir / "bad.json").string()).code, 2);
+}

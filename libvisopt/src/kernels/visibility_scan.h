@@ -59,10 +59,11 @@ struct VisibilityScan {
     return du * dv / (r2 * sqrtf(r2));
   }
 
-  // mu and g at a cell centre; zero outside the volume's box.
-  // opaque: the cell centre lies inside a context surface.
-  VISOPT_HD VISOPT_INLINE bool sampleAt(int i, int j, int k, float& m, float& g, bool& opaque) const {
-    const glm::vec3 idx = volume.toIndex(frustum.toWorld(glm::vec3(float(i), float(j), float(k))));
+  // mu and g at the cell centre o + s d (o, d: the ray in index space, s: depth); zero outside
+  // the volume's cells. opaque: the cell centre lies inside a context surface.
+  VISOPT_HD VISOPT_INLINE bool sampleAt(glm::vec3 o, glm::vec3 d, float depth, float& m, float& g,
+                                        bool& opaque) const {
+    const glm::vec3 idx = o + depth * d;
     // The volume occupies its voxels' cells, [-0.5, dims - 0.5] in index space (sampling clamps
     // beyond the outer voxel centres), so every voxel, boundary voxels included, is covered by
     // frustum cells in proportion to its volume, as the gather in extinction_step.h assumes.
@@ -82,6 +83,9 @@ struct VisibilityScan {
     const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
     const int nz = frustum.dims.z;
     const float ds = frustum.ds;
+    // The ray in index space, computed once: cell k's centre is o + depth(k) d.
+    const glm::vec3 o = volume.toIndex(frustum.eye);
+    const glm::vec3 d = volume.directionToIndex(frustum.rayDirection(float(i), float(j)));
     const float w = weights.active() ? weights.at(i, j, frustum.dims.x, frustum.dims.y) : 1.f;
     // Front to back: exclusive transmittance; a surface blocks everything from its first cell.
     float opticalDepth = 0.f;
@@ -89,7 +93,7 @@ struct VisibilityScan {
     for (int k = 0; k < nz; ++k) {
       float m, g;
       bool opaque;
-      sampleAt(i, j, k, m, g, opaque);
+      sampleAt(o, d, frustum.depthOf(float(k)), m, g, opaque);
       blocked = blocked || opaque;
       out.store(out.index(i, j, k), blocked ? 0.f : expf(-opticalDepth));
       opticalDepth += m * ds;
@@ -102,7 +106,7 @@ struct VisibilityScan {
     for (int k = nz - 1; k >= 0; --k) {
       float m, g;
       bool opaque;
-      sampleAt(i, j, k, m, g, opaque);
+      sampleAt(o, d, frustum.depthOf(float(k)), m, g, opaque);
       g = fminf(g * w, 1.f);
       if (behindMax.valid()) {
         behindMax.store(behindMax.index(i, j, k), runningMax);

@@ -32,6 +32,7 @@ nlohmann::json statsJson(const IterationStats& s) {
           {"energy_r", s.energyR},
           {"visibility_view", s.visibilityView},
           {"visibility_light", s.visibilityLight},
+          {"visibility_view_occluders", s.visibilityViewOccluders},
           {"step_norm", s.stepNorm},
           {"grid_updates_ms", s.gridUpdatesMs},
           {"extinction_step_ms", s.extinctionStepMs},
@@ -189,9 +190,9 @@ Runner addOptimizeCommand(CLI::App& app) {
     auto stats = engine.optimize([&](const IterationStats& st) {
       if (!o->json && !o->quiet)
         std::fprintf(stderr,
-                     "level %d  iteration %3d  energy %+.5e  V_view %.3f  V_light %.3f  step %.2e\n",
-                     st.level, st.iteration, st.energy(), st.visibilityView, st.visibilityLight,
-                     st.stepNorm);
+                     "level %d  iteration %3d  energy %+.5e  V_view %.3f (occluders %.3f)  V_light %.3f  step %.2e\n",
+                     st.level, st.iteration, st.energy(), st.visibilityView,
+                     st.visibilityViewOccluders, st.visibilityLight, st.stepNorm);
       return !interrupted.load();
     });
     const double optimizeMs = msSince(tOpt);

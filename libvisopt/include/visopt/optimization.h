@@ -52,6 +52,9 @@ struct IterationStats {
   double energy() const { return energyRho + energyQ + energyR; }
   double visibilityView = 0.0;   // V = ∫ g mu T_V / ∫ g mu over the view frustum
   double visibilityLight = 0.0;  // the same from the light (0 when r = 0)
+  // V with T_V taken through unimportant matter only: how much the occluders hide the important
+  // structures, leaving out their own fronts (the energy raises mu inside them, Eq. 12).
+  double visibilityViewOccluders = 0.0;
   double stepNorm = 0.0;         // RMS of the change of mu over the voxels
   double gridUpdatesMs = 0.0;    // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
   double extinctionStepMs = 0.0; // gather, optimiser step, projection ("Ext. Opt.")

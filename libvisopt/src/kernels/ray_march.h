@@ -6,9 +6,21 @@
 // then T_V *= exp(-mu h). The phase function f_p blends Henyey-Greenstein with normalised
 // Blinn-Phong about the scalar gradient (as Ament et al. 2017 combine them).
 // The surface term (Eq. 8) will enter here as the reduced surface radiance at the first hit.
+//
+// Performance notes (the arithmetic is the same as the straightforward formulation):
+//  - value and central-difference gradient come from one 32-voxel neighbourhood
+//    (kernels/ray_stencil.h) instead of seven trilinear samples;
+//  - everything that is linear along the ray (world position, its offset from the light, the
+//    light frustum's projection numerators) is set up once per ray: a T_L lookup costs one
+//    square root and two divisions, and the surface bias towards the light (along the light's
+//    own ray) only shortens the depth coordinate;
+//  - exp and pow use short polynomials on the host (kernels/ray_fast_math.h);
+//  - pixels are launched in 8x8 tiles in scanline order within a tile, so that neighbouring
+//    rays (and, on the GPU, a warp's threads) share the voxels they fetch.
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -17,6 +29,8 @@
 #include "core/frustum_map.h"
 #include "core/hd.h"
 #include "kernels/ray_box.h"
+#include "kernels/ray_fast_math.h"
+#include "kernels/ray_stencil.h"
 #include "kernels/transfer_lookup.h"
 
 namespace visopt {
@@ -36,7 +50,7 @@ VISOPT_HD inline float blinnPhong(glm::vec3 n, glm::vec3 toLight, glm::vec3 toEy
   if (cosL <= 0.f) return 0.f;
   glm::vec3 h = glm::normalize(toLight + toEye);
   float cosH = fmaxf(glm::dot(n, h), 0.f);
-  return (kd / kPi + ks * (shininess + 8.f) / (8.f * kPi) * powf(cosH, shininess)) * cosL;
+  return (kd / kPi + ks * (shininess + 8.f) / (8.f * kPi) * rayPowUnit(cosH, shininess)) * cosL;
 }
 
 // A small integer hash for per-pixel jitter (deterministic for a seed).
@@ -47,6 +61,15 @@ VISOPT_HD inline float hashToUnit(uint32_t x) {
   x *= 0x846ca68bU;
   x ^= x >> 16;
   return float(x >> 8) * (1.f / 16777216.f);
+}
+
+// Pixels are launched in tiles of kRayTile x kRayTile, row by row within a tile.
+constexpr int kRayTile = 8;
+
+// Launch items for a w x h image (whole tiles; items outside the image do nothing).
+inline int64_t rayMarchItems(int w, int h) {
+  const int64_t tilesX = (w + kRayTile - 1) / kRayTile, tilesY = (h + kRayTile - 1) / kRayTile;
+  return tilesX * tilesY * kRayTile * kRayTile;
 }
 
 struct RayMarchParams {
@@ -71,30 +94,96 @@ struct RayMarchParams {
 
 struct RayMarchKernel {
   RayMarchParams p;
+  // Derived once on the host (see the constructor).
+  glm::mat3 gradientToWorld{1.f};  // index-space gradient -> world direction
+  bool lightAtFrustumEye = false;  // the light frustum's eye is the light (the fast T_L lookup)
+  float hgNorm = 0.f, hgA = 1.f, hgB = 0.f;  // HG = hgNorm / (d sqrt d), d = hgA - hgB cos
+  float kdNorm = 0.f, ksNorm = 0.f;          // kd / pi, ks (n + 8) / (8 pi)
+  float lightGridScaleX = 1.f, lightGridScaleY = 1.f, lightGridOffsetX = 0.f,
+        lightGridOffsetY = 0.f;  // pixel coordinate = numerator / z * scale + offset
+  float lightInvDs = 1.f, lightDepthOffset = 0.f;  // depth coordinate = s / ds - offset
 
-  VISOPT_HD float extinctionAt(glm::vec3 idx, float tfExtinction) const {
-    return p.extinction.valid() ? p.extinction.sample(idx) : tfExtinction;
+  explicit RayMarchKernel(const RayMarchParams& params) : p(params) {
+    const glm::vec3 invSpacing = 1.f / p.volume.spacing;
+    gradientToWorld = p.volume.direction * glm::mat3(glm::vec3(invSpacing.x, 0.f, 0.f),
+                                                     glm::vec3(0.f, invSpacing.y, 0.f),
+                                                     glm::vec3(0.f, 0.f, invSpacing.z));
+    lightAtFrustumEye = p.light.eye == p.lightPosition;
+    hgNorm = (1.f - p.hg * p.hg) / (4.f * kPi);
+    hgA = 1.f + p.hg * p.hg;
+    hgB = 2.f * p.hg;
+    kdNorm = p.kd / kPi;
+    ksNorm = p.ks * (p.shininess + 8.f) / (8.f * kPi);
+    lightGridScaleX = 0.5f * float(p.light.dims.x) / p.light.tanX;
+    lightGridScaleY = 0.5f * float(p.light.dims.y) / p.light.tanY;
+    lightGridOffsetX = 0.5f * float(p.light.dims.x) - 0.5f;
+    lightGridOffsetY = 0.5f * float(p.light.dims.y) - 0.5f;
+    lightInvDs = 1.f / p.light.ds;
+    lightDepthOffset = p.light.sNear / p.light.ds + 0.5f;
   }
 
-  // At surface-like samples (bias = the Blinn-Phong weight) T_L is looked up up to one light-grid
-  // cell towards the light: like a shadow map's depth bias, this keeps an opaque surface from
-  // shadowing itself through the grid's discretisation (moiré rings where the light grid's cells
-  // cut the surface). Homogeneous media (bias 0) keep the exact lookup.
-  VISOPT_HD float lightTransmittanceAt(glm::vec3 x, glm::vec3 toLight, float bias) const {
+  VISOPT_HD VISOPT_INLINE float phaseHG(float cosTheta) const {
+    const float d = hgA - hgB * cosTheta;
+    return hgB == 0.f ? hgNorm : hgNorm / (d * sqrtf(d));
+  }
+
+  // Per-ray linear forms for the light: with x(t) = eye + t dir the world position,
+  // x - lightPosition = e + t dir, and the components of x - light.eye along the light
+  // frustum's axes, A + t B (used when the frustum's eye is the light).
+  struct LightRay {
+    glm::vec3 e;                   // camera eye - light position
+    float zA, zB, uA, uB, vA, vB;  // x - light.eye along forward, right * scaleX, up * scaleY
+  };
+
+  VISOPT_HD VISOPT_INLINE LightRay lightRay(glm::vec3 eye, glm::vec3 dir) const {
+    LightRay r;
+    r.e = eye - p.lightPosition;
+    const glm::vec3 ef = eye - p.light.eye;
+    r.zA = glm::dot(ef, p.light.forward);
+    r.zB = glm::dot(dir, p.light.forward);
+    r.uA = glm::dot(ef, p.light.right) * lightGridScaleX;
+    r.uB = glm::dot(dir, p.light.right) * lightGridScaleX;
+    r.vA = glm::dot(ef, p.light.up) * lightGridScaleY;
+    r.vB = glm::dot(dir, p.light.up) * lightGridScaleY;
+    return r;
+  }
+
+  // T_L at the sample at distance t along the ray, dist = |x - light.eye|. At surface-like
+  // samples (bias = the Blinn-Phong weight) T_L is looked up up to one light-grid cell towards
+  // the light: like a shadow map's depth bias, this keeps an opaque surface from shadowing
+  // itself through the grid's discretisation (moiré rings where the light grid's cells cut the
+  // surface). Homogeneous media (bias 0) keep the exact lookup. Moving x towards the light along
+  // the light's own ray keeps its frustum pixel and shortens its distance by bias * ds.
+  VISOPT_HD VISOPT_INLINE float lightTransmittanceAt(const LightRay& r, float t, float dist,
+                                                     glm::vec3 x, glm::vec3 toLight,
+                                                     float bias) const {
     if (!p.lightTransmittance.valid()) return 1.f;
-    glm::vec3 y = p.light.toGrid(x + (bias * p.light.ds) * toLight);
+    glm::vec3 y;
+    if (lightAtFrustumEye) {
+      const float z = r.zA + t * r.zB;
+      const float s = dist - bias * p.light.ds;
+      if (z <= 0.f || s <= 0.f) return 1.f;  // behind the light: outside the frustum
+      const float invZ = 1.f / z;
+      y = glm::vec3((r.uA + t * r.uB) * invZ + lightGridOffsetX,
+                    (r.vA + t * r.vB) * invZ + lightGridOffsetY, s * lightInvDs - lightDepthOffset);
+    } else {
+      y = p.light.toGrid(x + (bias * p.light.ds) * toLight);
+    }
     if (!p.lightTransmittance.inside(y)) return 1.f;
-    return p.lightTransmittance.sample(y);
+    return raySample(p.lightTransmittance, y);
   }
 
-  // Returns the number of volume samples taken for pixel `pixel`.
-  VISOPT_HD int64_t operator()(int64_t pixel) const {
-    const int w = p.camera.dims.x, h = p.camera.dims.y;
-    const int px = int(pixel % w), row = int(pixel / w);
+  // Marches the ray of pixel (px, row); T is the storage type of the scalars. Returns the
+  // number of volume samples taken.
+  template <class T>
+  VISOPT_HD int64_t march(int px, int row, int64_t pixel) const {
+    const int h = p.camera.dims.y;
     const int py = h - 1 - row;
     const glm::vec3 dir = p.camera.rayDirection(float(px), float(py));
     const glm::vec3 o = p.volume.toIndex(p.camera.eye);
     const glm::vec3 d = p.volume.directionToIndex(dir);  // index units per world unit
+    const T* scalars = static_cast<const T*>(p.scalars.data);
+    const glm::ivec3 dims = p.scalars.dims;
 
     const RayInterval box = intersectBox(o, d, glm::vec3(p.volume.dims - 1));
     const float t0 = box.t0, t1 = box.t1;
@@ -106,49 +195,78 @@ struct RayMarchKernel {
       const float seg = (t1 - t0) / float(count);
       const float offset = p.jitter ? hashToUnit(uint32_t(pixel) * 9781u + p.seed * 6271u) : 0.5f;
       const glm::vec3 toEye = -dir;
+      const bool shade = p.kd > 0.f || p.ks > 0.f;
+      const LightRay lr = lightRay(p.camera.eye, dir);
+      const glm::vec3 ambient(p.ambient);
       for (int s = 0; s < count && transmittance > p.earlyStop; ++s) {
         const float t = t0 + (float(s) + offset) * seg;
         const glm::vec3 idx = o + t * d;
         ++samples;
-        const float value = p.scalars.sample(idx);
-        const glm::vec4 tf = p.transfer.at(value);
-        const float mu = extinctionAt(idx, tf.w);
+        const RayStencil<T> stencil(scalars, dims, idx);
+        float c[8];
+        stencil.corners(c);
+        const float value = stencil.value(c);
+        const TransferLookup::Entry entry = p.transfer.locate(value);
+        const float mu =
+            p.extinction.valid() ? raySample(p.extinction, idx) : p.transfer.extinction(entry);
         const float opticalDepth = mu * seg;
         if (opticalDepth < 1e-7f) continue;
-        const float alpha = 1.f - expf(-opticalDepth);
-        const glm::vec3 albedo(tf.x, tf.y, tf.z);
-        const glm::vec3 x = p.volume.toWorld(idx);
+        const float alpha = raySegmentAlpha(opticalDepth);
+        const glm::vec3 albedo = p.transfer.albedo(entry);
+
+        // Direction and distance to the light from x = eye + t dir.
+        const glm::vec3 fromLight = lr.e + t * dir;
+        const float dist = sqrtf(glm::dot(fromLight, fromLight));
+        const glm::vec3 toLight = fromLight * (-1.f / dist);
 
         // Phase function: HG blended with Blinn-Phong about the gradient.
-        const glm::vec3 toLight = glm::normalize(p.lightPosition - x);
-        float phase = henyeyGreenstein(glm::dot(toLight, dir), p.hg);
+        float phase = phaseHG(glm::dot(toLight, dir));
         float surfaceWeight = 0.f;
         // Gradient shading only where the sample can still be seen: below that its effect on
         // the pixel is under 1e-4 of the light's radiance.
-        if ((p.kd > 0.f || p.ks > 0.f) && transmittance * alpha > 1e-4f) {
-          glm::vec3 gi(p.scalars.sample(idx + glm::vec3(1, 0, 0)) - p.scalars.sample(idx - glm::vec3(1, 0, 0)),
-                       p.scalars.sample(idx + glm::vec3(0, 1, 0)) - p.scalars.sample(idx - glm::vec3(0, 1, 0)),
-                       p.scalars.sample(idx + glm::vec3(0, 0, 1)) - p.scalars.sample(idx - glm::vec3(0, 0, 1)));
-          gi *= 0.5f;  // normalised value change per voxel along each index axis
-          const float perVoxel = glm::length(gi);
+        if (shade && transmittance * alpha > 1e-4f) {
+          const glm::vec3 g2 = stencil.gradient2(c);  // twice the per-voxel gradient
+          const float perVoxel = 0.5f * glm::length(g2);
           const float weight = fminf(perVoxel / p.surfaceGradient, 1.f);
           surfaceWeight = weight;
           if (weight > 0.f) {
-            const glm::vec3 gw = p.volume.direction * (gi / p.volume.spacing);
-            const glm::vec3 n = glm::normalize(gw);
-            phase = (1.f - weight) * phase +
-                    weight * blinnPhong(n, toLight, toEye, p.kd, p.ks, p.shininess);
+            glm::vec3 n = glm::normalize(gradientToWorld * g2);
+            if (glm::dot(n, toEye) < 0.f) n = -n;  // two-sided
+            const float cosL = glm::dot(n, toLight);
+            float bp = 0.f;
+            if (cosL > 0.f) {
+              float lobe = kdNorm;
+              if (ksNorm > 0.f) {
+                const glm::vec3 half = glm::normalize(toLight + toEye);
+                lobe += ksNorm * rayPowUnit(fmaxf(glm::dot(n, half), 0.f), p.shininess);
+              }
+              bp = lobe * cosL;
+            }
+            phase = (1.f - weight) * phase + weight * bp;
           }
         }
-        const float lightT = lightTransmittanceAt(x, toLight, surfaceWeight);
-        radiance += transmittance * alpha * albedo *
-                    (phase * lightT * p.lightRadiance + glm::vec3(p.ambient));
+        const float lightT = lightTransmittanceAt(lr, t, dist, p.camera.eye + t * dir, toLight,
+                                                  surfaceWeight);
+        radiance += transmittance * alpha * albedo * (phase * lightT * p.lightRadiance + ambient);
         transmittance *= 1.f - alpha;
       }
     }
     radiance += transmittance * p.background;
     p.pixels[pixel] = radiance;
     return samples;
+  }
+
+  // Launch item -> pixel (see rayMarchItems); returns the number of volume samples taken.
+  VISOPT_HD int64_t operator()(int64_t item) const {
+    const int w = p.camera.dims.x, h = p.camera.dims.y;
+    const int tilesX = (w + kRayTile - 1) / kRayTile;
+    const int64_t tile = item / (kRayTile * kRayTile);
+    const int local = int(item % (kRayTile * kRayTile));
+    const int px = int(tile % tilesX) * kRayTile + local % kRayTile;
+    const int row = int(tile / tilesX) * kRayTile + local / kRayTile;
+    if (px >= w || row >= h) return 0;
+    const int64_t pixel = int64_t(row) * w + px;
+    return p.scalars.half ? march<Half>(px, row, pixel) : march<float>(px, row, pixel);
   }
 };
 

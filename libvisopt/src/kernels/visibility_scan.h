@@ -36,7 +36,13 @@ namespace visopt {
 struct ScanSums {
   double gMuT = 0.0;  // sum g mu T dV  (the visibility integral; energy term = -weight * this)
   double gMu = 0.0;   // sum g mu dV
-  VISOPT_HD ScanSums operator+(const ScanSums& o) const { return {gMuT + o.gMuT, gMu + o.gMu}; }
+  // sum g mu T_occ dV, with T_occ the transmittance through unimportant matter only,
+  // exp(-integral (1 - g) mu): how much the occluders (not the important structure's own
+  // front) hide it.
+  double gMuTOccluders = 0.0;
+  VISOPT_HD ScanSums operator+(const ScanSums& o) const {
+    return {gMuT + o.gMuT, gMu + o.gMu, gMuTOccluders + o.gMuTOccluders};
+  }
 };
 
 struct VisibilityScan {
@@ -88,7 +94,9 @@ struct VisibilityScan {
     const glm::vec3 d = volume.directionToIndex(frustum.rayDirection(float(i), float(j)));
     const float w = weights.active() ? weights.at(i, j, frustum.dims.x, frustum.dims.y) : 1.f;
     // Front to back: exclusive transmittance; a surface blocks everything from its first cell.
-    float opticalDepth = 0.f;
+    const float omega = solidAngle(i, j);
+    ScanSums sums;
+    float opticalDepth = 0.f, occluderDepth = 0.f;
     bool blocked = false;
     for (int k = 0; k < nz; ++k) {
       float m, g;
@@ -97,10 +105,14 @@ struct VisibilityScan {
       blocked = blocked || opaque;
       out.store(out.index(i, j, k), blocked ? 0.f : expf(-opticalDepth));
       opticalDepth += m * ds;
+      const float gw = fminf(g * w, 1.f);
+      if (!blocked && gw > 0.f) {
+        const float s = frustum.depthOf(float(k));
+        sums.gMuTOccluders += double(gw * m * expf(-occluderDepth)) * double(omega * s * s * ds);
+      }
+      occluderDepth += (1.f - gw) * m * ds;
     }
     // Back to front: G (behind, weighted by s^2) and d = g T - G.
-    const float omega = solidAngle(i, j);
-    ScanSums sums;
     float behind = 0.f;  // sum_{j>k} g mu T s^2 ds
     float runningMax = 0.f;  // max_{j>k} g
     for (int k = nz - 1; k >= 0; --k) {

@@ -429,6 +429,7 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   st.energyQ = -double(p.q) * view.gMuT;
   st.energyR = -double(p.r) * light.gMuT;
   st.visibilityView = view.gMu > 0 ? view.gMuT / view.gMu : 0.0;
+  st.visibilityViewOccluders = view.gMu > 0 ? view.gMuTOccluders / view.gMu : 0.0;
   st.visibilityLight = light.gMu > 0 ? light.gMuT / light.gMu : 0.0;
   st.stepNorm = std::sqrt(sums.step2 / double(L.grid.voxelCount()));
   if (hasSurfaces) surfaceStep(in, L, st);

@@ -96,9 +96,9 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
 
   DeviceBuffer<glm::vec3> pixels(size_t(w) * size_t(h));
   p.pixels = pixels.data();
-  RayMarchKernel kernel{p};
+  const RayMarchKernel kernel(p);
   const int64_t samples = exec::reduce(
-      "render", int64_t(w) * h, int64_t(0), kernel,
+      "render", rayMarchItems(w, h), int64_t(0), kernel,
       [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
 
   Image image(w, h);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "visopt/camera.h"
+#include "visopt/context_surface.h"
 #include "visopt/precision.h"
 #include "visopt/transfer_function.h"
 #include "visopt/volume.h"
@@ -30,6 +31,10 @@ struct BuiltinScene {
   // The same structures as a curve over normalised values, points (t, g) — what a user could
   // set in an importance editor; may also catch edges that pass through the same values.
   std::vector<glm::vec2> importanceCurve;
+  // The scene's context surfaces (paper 000 §III) and the transfer function to use with them:
+  // what the surfaces show is then transparent in the volume. Empty for scenes without.
+  std::vector<ContextSurfaceSpec> contextSurfaces;
+  TransferFunction contextTransferFunction;
 };
 
 std::vector<SceneDescription> builtinScenes();

@@ -36,8 +36,9 @@ class Engine {
 
   // Scene input. Loading replaces the volume and frames the camera and light on it.
   void loadVolume(const std::string& path, const ProgressCallback& progress = {});
-  // Loads a built-in scene with its transfer function, view and light.
-  void loadBuiltinScene(const std::string& name, int resolution = 128);
+  // Loads a built-in scene with its transfer function, view, light and importance; with
+  // `contextSurfaces` also its context surfaces and the transfer function meant for them.
+  void loadBuiltinScene(const std::string& name, int resolution = 128, bool contextSurfaces = true);
   void setVolume(Volume volume);
   bool hasVolume() const;
   const Volume& volume() const;

@@ -7,7 +7,18 @@
 
 namespace visopt {
 
+// The comparison baselines of paper 000 Fig. 10, and ours.
+enum class RenderMethod {
+  Optimized,               // ours: the optimised extinction and surfaces
+  MaxImportanceProjection, // each pixel shows the sample of highest importance (surfaces too)
+  CutAway,                 // surfaces and volume removed where ghat exceeds a threshold
+  TransparencyModulation,  // surfaces and volume made transparent in proportion to ghat
+};
+const char* toString(RenderMethod method);
+
 struct RenderSettings {
+  RenderMethod method = RenderMethod::Optimized;
+  float cutAwayThreshold = 0.3f;  // ghat above this is cut away
   int width = 512, height = 512;
   // Ray-marching step, in units of the smallest voxel spacing. Each pixel's samples are
   // stratified with a per-pixel random offset (jitter) against wood-grain artefacts.

@@ -32,6 +32,7 @@ struct Engine::Impl {
   FrustumGrid lightFrustum;
   std::optional<Field3D> lightTransmittance;
   bool lightDirty = true;
+  bool lightOptimized = true;  // T_L was computed for the optimised scene
   int lightGridSize = 0, lightGridDepth = -1;
 
   std::optional<Field3D> importance;
@@ -107,13 +108,25 @@ struct Engine::Impl {
     lightDirty = true;
   }
 
-  RenderScene scene() const {
+  // The scene as drawn: `optimized` selects the optimised mu and surfaces (ours) or the base
+  // ones (mu_bar, phi0: the baselines and the "before" image).
+  RenderScene scene(bool optimized = true) const {
     RenderScene s;
     s.volume = &*volume;
     s.transfer = &table;
     s.camera = camera;
     s.light = light;
-    if (renderOptimized) s.extinction = optimizer.extinction();
+    const bool useOptimized = optimized && renderOptimized;
+    if (useOptimized) s.extinction = optimizer.extinction();
+    const auto phis = optimizer.surfaces();
+    for (size_t i = 0; i < surfaceSpecs.size(); ++i) {
+      if (!surfaceSpecs[i].visible) continue;
+      s.surfaces.push_back(useOptimized && i < phis.size() ? phis[i] : &surfaceBases[i]);
+      s.surfaceBases.push_back(&surfaceBases[i]);
+      s.surfaceColors.push_back(surfaceSpecs[i].color);
+    }
+    s.importanceBehind = optimizer.importanceBehind();
+    s.importance = importance ? &*importance : nullptr;
     if (lightTransmittance) {
       s.lightFrustum = &lightFrustum;
       s.lightTransmittance = &*lightTransmittance;
@@ -136,7 +149,7 @@ struct Engine::Impl {
     lg.dims = lightFrustum.dims;
     if (!lightTransmittance || lightTransmittance->grid().dims != lg.dims)
       lightTransmittance.emplace("light-transmittance", lg, precision, &ledger);
-    computeLightTransmittance(scene(), lightFrustum, *lightTransmittance);
+    computeLightTransmittance(scene(lightOptimized), lightFrustum, *lightTransmittance);
     lightGridSize = settings.lightGridSize;
     lightGridDepth = settings.lightGridDepth;
     lightDirty = false;
@@ -158,7 +171,7 @@ void Engine::loadVolume(const std::string& path, const ProgressCallback& progres
   impl_->frameView(0.f, 10.f, 2.6f);
 }
 
-void Engine::loadBuiltinScene(const std::string& name, int resolution) {
+void Engine::loadBuiltinScene(const std::string& name, int resolution, bool contextSurfaces) {
   impl_->clearScene();
   BuiltinScene scene = makeBuiltinScene(name, resolution, impl_->precision, &impl_->ledger);
   impl_->volume.emplace(std::move(scene.volume));
@@ -168,10 +181,14 @@ void Engine::loadBuiltinScene(const std::string& name, int resolution) {
   else if (!scene.importanceCurve.empty())
     impl_->importance.emplace(importanceFromNormalizedCurve(*impl_->volume, scene.importanceCurve,
                                                             impl_->precision, &impl_->ledger));
-  impl_->tf = std::move(scene.transferFunction);
+  const bool withSurfaces = contextSurfaces && !scene.contextSurfaces.empty();
+  impl_->tf = withSurfaces ? std::move(scene.contextTransferFunction)
+                           : std::move(scene.transferFunction);
   impl_->hasTf = true;
   impl_->invalidateAll();
   impl_->frameView(scene.azimuthDeg, scene.elevationDeg, scene.distanceInRadii);
+  if (withSurfaces)
+    for (const auto& spec : scene.contextSurfaces) addContextSurface(spec);
 }
 
 void Engine::setVolume(Volume volume) {
@@ -222,8 +239,11 @@ const PointLight& Engine::light() const { return impl_->light; }
 Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
   impl_->ensureTable();
+  const bool optimized = settings.method == RenderMethod::Optimized;
+  if (optimized != impl_->lightOptimized) impl_->lightDirty = true;  // T_L of the other scene
+  impl_->lightOptimized = optimized;
   double lightMs = impl_->ensureLight(settings);
-  Image image = renderImage(impl_->scene(), settings, stats);
+  Image image = renderImage(impl_->scene(optimized), settings, stats);
   if (stats) stats->lightMilliseconds = lightMs;
   return image;
 }

@@ -34,8 +34,36 @@ VISOPT_HD VISOPT_INLINE float rayLoadHalf(const Half* data, size_t i) {
 
 // Loads element i of fp32 or fp16 storage as fp32 (the run-time precision of a FieldView).
 VISOPT_HD VISOPT_INLINE float rayLoad(const void* data, bool half, size_t i) {
-  return half ? rayLoadHalf(static_cast<const Half*>(data), i)
-              : static_cast<const float*>(data)[i];
+  return half ? rayLoadHalf(static_cast<const Half*>(data), i) : static_cast<const float*>(data)[i];
+}
+
+#if !defined(__CUDA_ARCH__) && defined(__SSE__)
+#include <xmmintrin.h>
+#define VISOPT_RAY_SSE 1
+#endif
+
+// 1 / sqrt(x) for x > 0 and 1 / x: on the host the hardware estimates refined by one Newton
+// step (relative error below 1e-6), which keep the divider free; sqrtf and division otherwise.
+VISOPT_HD VISOPT_INLINE float rayRsqrt(float x) {
+#if defined(__CUDA_ARCH__)
+  return rsqrtf(x);
+#elif defined(VISOPT_RAY_SSE)
+  const float r = _mm_cvtss_f32(_mm_rsqrt_ss(_mm_set_ss(x)));
+  return r * (1.5f - 0.5f * x * r * r);
+#else
+  return 1.f / sqrtf(x);
+#endif
+}
+
+VISOPT_HD VISOPT_INLINE float rayRcp(float x) {
+#if defined(__CUDA_ARCH__)
+  return 1.f / x;
+#elif defined(VISOPT_RAY_SSE)
+  const float r = _mm_cvtss_f32(_mm_rcp_ss(_mm_set_ss(x)));
+  return r * (2.f - x * r);
+#else
+  return 1.f / x;
+#endif
 }
 
 #if !defined(__CUDA_ARCH__)
@@ -62,7 +90,7 @@ VISOPT_HD VISOPT_INLINE float rayExp2(float x) {
 #if defined(__CUDA_ARCH__)
   return exp2f(x);
 #else
-  x = fminf(fmaxf(x, -126.f), 126.f);
+  x = x < -126.f ? -126.f : (x > 126.f ? 126.f : x);
   // x = k + r with k = round(x), |r| <= 1/2; the shift makes the truncation a floor.
   const int k = int(x + 127.5f) - 127;
   const float y = (x - float(k)) * 0.693147180559945f;  // e^y = 2^r, |y| <= 0.347
@@ -92,7 +120,7 @@ VISOPT_HD VISOPT_INLINE float rayLog2(float x) {
     ++e;
   }
   // ln m = 2 atanh(z), z = (m - 1) / (m + 1), |z| <= 0.1716: odd series to z^9.
-  const float z = (m - 1.f) / (m + 1.f);
+  const float z = (m - 1.f) * rayRcp(m + 1.f);
   const float z2 = z * z;
   float s = 1.f / 9.f;
   s = s * z2 + 1.f / 7.f;
@@ -104,14 +132,29 @@ VISOPT_HD VISOPT_INLINE float rayLog2(float x) {
 }
 
 // x^y for x in [0, 1] and y > 0 (the Blinn-Phong lobe); x^0 = 1.
-VISOPT_HD VISOPT_INLINE float rayPowUnit(float x, float y) {
+// yInt: y when y is a whole number in [1, 1024] (then x^y is a few exact squarings), else 0.
+VISOPT_HD VISOPT_INLINE float rayPowUnit(float x, float y, int yInt) {
 #if defined(__CUDA_ARCH__)
+  (void)yInt;
   return powf(x, y);
 #else
+  if (yInt > 0) {
+    float result = 1.f;
+    for (unsigned n = unsigned(yInt); n != 0u; n >>= 1u) {
+      if (n & 1u) result *= x;
+      x *= x;
+    }
+    return result;
+  }
   if (y == 0.f) return 1.f;
   if (x < 1e-30f) return 0.f;
   return rayExp2(y * rayLog2(x));
 #endif
+}
+
+// The yInt argument of rayPowUnit for exponent y.
+inline int rayWholeExponent(float y) {
+  return y >= 1.f && y <= 1024.f && float(int(y)) == y ? int(y) : 0;
 }
 
 // The opacity of a segment of optical depth tau >= 0: 1 - exp(-tau), without cancellation for

@@ -5,7 +5,11 @@
 // its in-scattering weight is T_V * (1 - exp(-mu h)) (= integral of T_V mu over the segment),
 // then T_V *= exp(-mu h). The phase function f_p blends Henyey-Greenstein with normalised
 // Blinn-Phong about the scalar gradient (as Ament et al. 2017 combine them).
-// The surface term (Eq. 8) will enter here as the reduced surface radiance at the first hit.
+// The surface term (Eq. 8) enters as the reduced surface radiance at the first hit of a context
+// surface, found by sphere tracing before the volume march, which then stops there.
+// Baselines of Fig. 10: cut-away drops surface and volume where ghat > threshold; transparency
+// modulation scales opacity by (1 - ghat) and blends the first surface with what lies behind;
+// maximum importance projection shows the sample (volume or surface) of highest g.
 //
 // Performance notes (the arithmetic is the same as the straightforward formulation):
 //  - value and central-difference gradient come from one 32-voxel neighbourhood
@@ -30,13 +34,17 @@
 #include "core/hd.h"
 #include "kernels/ray_box.h"
 #include "kernels/ray_fast_math.h"
+#include "kernels/ray_skip.h"
 #include "kernels/ray_stencil.h"
+#include "kernels/surface_render.h"
 #include "kernels/transfer_lookup.h"
 
 namespace visopt {
 
 constexpr float kPi = 3.14159265358979f;
 
+// Reference forms of the two phase functions; RayMarchKernel evaluates the same expressions with
+// per-launch constants folded in.
 VISOPT_HD inline float henyeyGreenstein(float cosTheta, float g) {
   float d = 1.f + g * g - 2.f * g * cosTheta;
   return (1.f - g * g) / (4.f * kPi * d * sqrtf(d));
@@ -50,7 +58,7 @@ VISOPT_HD inline float blinnPhong(glm::vec3 n, glm::vec3 toLight, glm::vec3 toEy
   if (cosL <= 0.f) return 0.f;
   glm::vec3 h = glm::normalize(toLight + toEye);
   float cosH = fmaxf(glm::dot(n, h), 0.f);
-  return (kd / kPi + ks * (shininess + 8.f) / (8.f * kPi) * rayPowUnit(cosH, shininess)) * cosL;
+  return (kd / kPi + ks * (shininess + 8.f) / (8.f * kPi) * powf(cosH, shininess)) * cosL;
 }
 
 // A small integer hash for per-pixel jitter (deterministic for a seed).
@@ -90,6 +98,8 @@ struct RayMarchParams {
   glm::vec3 background{0.f};
   float earlyStop = 1e-4f;
   glm::vec3* pixels = nullptr;  // row 0 at the top
+  RaySkipGrid skip;             // empty blocks of the volume (kernels/ray_skip.h); optional
+  SurfaceRenderParams surf;     // context surfaces and baselines (kernels/surface_render.h)
 };
 
 struct RayMarchKernel {
@@ -99,9 +109,12 @@ struct RayMarchKernel {
   bool lightAtFrustumEye = false;  // the light frustum's eye is the light (the fast T_L lookup)
   float hgNorm = 0.f, hgA = 1.f, hgB = 0.f;  // HG = hgNorm / (d sqrt d), d = hgA - hgB cos
   float kdNorm = 0.f, ksNorm = 0.f;          // kd / pi, ks (n + 8) / (8 pi)
+  float halfInvSurfaceGradient = 1.f;        // 0.5 / surfaceGradient
+  int shininessInt = 0;                      // see rayWholeExponent
   float lightGridScaleX = 1.f, lightGridScaleY = 1.f, lightGridOffsetX = 0.f,
         lightGridOffsetY = 0.f;  // pixel coordinate = numerator / z * scale + offset
   float lightInvDs = 1.f, lightDepthOffset = 0.f;  // depth coordinate = s / ds - offset
+  glm::vec3 lightSupport{0.f};                     // T_L grid dims - 0.5
 
   explicit RayMarchKernel(const RayMarchParams& params) : p(params) {
     const glm::vec3 invSpacing = 1.f / p.volume.spacing;
@@ -113,18 +126,22 @@ struct RayMarchKernel {
     hgA = 1.f + p.hg * p.hg;
     hgB = 2.f * p.hg;
     kdNorm = p.kd / kPi;
+    halfInvSurfaceGradient = 0.5f / p.surfaceGradient;
+    shininessInt = rayWholeExponent(p.shininess);
     ksNorm = p.ks * (p.shininess + 8.f) / (8.f * kPi);
     lightGridScaleX = 0.5f * float(p.light.dims.x) / p.light.tanX;
     lightGridScaleY = 0.5f * float(p.light.dims.y) / p.light.tanY;
     lightGridOffsetX = 0.5f * float(p.light.dims.x) - 0.5f;
     lightGridOffsetY = 0.5f * float(p.light.dims.y) - 0.5f;
     lightInvDs = 1.f / p.light.ds;
+    lightSupport = glm::vec3(p.lightTransmittance.dims) - 0.5f;
     lightDepthOffset = p.light.sNear / p.light.ds + 0.5f;
   }
 
   VISOPT_HD VISOPT_INLINE float phaseHG(float cosTheta) const {
     const float d = hgA - hgB * cosTheta;
-    return hgB == 0.f ? hgNorm : hgNorm / (d * sqrtf(d));
+    const float r = rayRsqrt(d);
+    return hgB == 0.f ? hgNorm : hgNorm * (r * r * r);
   }
 
   // Per-ray linear forms for the light: with x(t) = eye + t dir the world position,
@@ -163,13 +180,16 @@ struct RayMarchKernel {
       const float z = r.zA + t * r.zB;
       const float s = dist - bias * p.light.ds;
       if (z <= 0.f || s <= 0.f) return 1.f;  // behind the light: outside the frustum
-      const float invZ = 1.f / z;
+      const float invZ = rayRcp(z);
       y = glm::vec3((r.uA + t * r.uB) * invZ + lightGridOffsetX,
                     (r.vA + t * r.vB) * invZ + lightGridOffsetY, s * lightInvDs - lightDepthOffset);
     } else {
       y = p.light.toGrid(x + (bias * p.light.ds) * toLight);
     }
-    if (!p.lightTransmittance.inside(y)) return 1.f;
+    // Outside the cell-centred grid's support [-0.5, dims - 0.5]: unshadowed.
+    if (!(y.x >= -0.5f && y.y >= -0.5f && y.z >= -0.5f && y.x <= lightSupport.x &&
+          y.y <= lightSupport.y && y.z <= lightSupport.z))
+      return 1.f;
     return raySample(p.lightTransmittance, y);
   }
 
@@ -186,10 +206,82 @@ struct RayMarchKernel {
     const glm::ivec3 dims = p.scalars.dims;
 
     const RayInterval box = intersectBox(o, d, glm::vec3(p.volume.dims - 1));
-    const float t0 = box.t0, t1 = box.t1;
+    const float t0 = box.t0;
+    float t1 = box.t1;
     glm::vec3 radiance(0.f);
     float transmittance = 1.f;
     int64_t samples = 0;
+    const RayMethod method = p.surf.method;
+    // Context surfaces: the first hit ends the volume march (except for transparency
+    // modulation, which blends the surface and marches on).
+    SurfaceHit hit;
+    if (!p.surf.surfaces.empty() && t1 > t0) {
+      hit = traceSurfaces(p.surf.surfaces, o, d, t0, t1, p.surf.minStep);
+      if (hit.hit && method == RayMethod::CutAway) {
+        // Cut away: a hit inside the cut region does not count; look for one beyond it.
+        float from = hit.t;
+        for (int tries = 0; tries < 8 && hit.hit &&
+                            p.surf.importanceBehind.sample(o + hit.t * d) > p.surf.cutThreshold;
+             ++tries) {
+          // Leave the surface (and the cut region's interior) before tracing on.
+          from = hit.t + p.surf.minStep;
+          while (from < t1 && p.surf.surfaces.unionAt(o + from * d) <= 0.f) from += p.surf.minStep;
+          hit = traceSurfaces(p.surf.surfaces, o, d, from, t1, p.surf.minStep);
+        }
+        if (hit.hit && p.surf.importanceBehind.sample(o + hit.t * d) > p.surf.cutThreshold)
+          hit = SurfaceHit{};
+      }
+    }
+    glm::vec3 surfaceColour(0.f);
+    float surfaceAlpha = 0.f;
+    if (hit.hit) {
+      const glm::vec3 hidx = o + hit.t * d;
+      const glm::vec3 x = p.camera.eye + hit.t * dir;
+      glm::vec3 n = surfaceNormal(p.surf.surfaces.phi[hit.surface], hidx, p.volume);
+      if (glm::dot(n, dir) > 0.f) n = -n;  // the side facing the viewer
+      const glm::vec3 toLight = glm::normalize(p.lightPosition - x);
+      // T_L just outside the surface, along its normal (the field is 0 inside it).
+      const float lightT = p.lightTransmittance.valid()
+                               ? [&] {
+                                   const glm::vec3 y = p.light.toGrid(x + p.light.ds * n);
+                                   return (y.x >= -0.5f && y.y >= -0.5f && y.z >= -0.5f &&
+                                           y.x <= lightSupport.x && y.y <= lightSupport.y &&
+                                           y.z <= lightSupport.z)
+                                              ? raySample(p.lightTransmittance, y)
+                                              : 1.f;
+                                 }()
+                               : 1.f;
+      // Volume ambient occlusion: transmittance through mu along the normal.
+      float volumeOcclusion = 1.f;
+      if (p.surf.ambientOcclusion) {
+        float depth = 0.f;
+        for (int i = 1; i <= 4; ++i) {
+          const float dist = p.surf.aoRadius * float(i) / 4.f;
+          const glm::vec3 q = p.volume.toIndex(x + dist * n);
+          const glm::vec3 hi = glm::vec3(p.volume.dims - 1);
+          if (q.x < 0.f || q.y < 0.f || q.z < 0.f || q.x > hi.x || q.y > hi.y || q.z > hi.z) break;
+          const float mu = p.extinction.valid()
+                               ? raySample(p.extinction, q)
+                               : p.transfer.extinction(p.transfer.locate(raySample(p.scalars, q)));
+          depth += mu * 0.25f * p.surf.aoRadius;
+        }
+        volumeOcclusion = expf(-depth);
+      }
+      surfaceColour = surfaceRadiance(p.surf, p.volume, hit.surface, hidx, x, n, toLight, -dir,
+                                      lightT, p.lightRadiance, p.ambient, volumeOcclusion);
+      surfaceAlpha = 1.f;
+      if (method == RayMethod::Transparency)
+        surfaceAlpha = 1.f - fminf(fmaxf(p.surf.importanceBehind.sample(hidx), 0.f), 1.f);
+      else
+        t1 = hit.t;
+    }
+    // Maximum importance projection: the most important sample's colour.
+    float bestG = 0.f;
+    glm::vec3 bestColour(0.f);
+    if (method == RayMethod::MaxImportance && hit.hit) {
+      bestG = p.surf.importance.sample(o + hit.t * d);
+      bestColour = surfaceColour;
+    }
     if (t1 > t0) {
       const int count = int(ceilf((t1 - t0) / p.step));
       const float seg = (t1 - t0) / float(count);
@@ -198,26 +290,56 @@ struct RayMarchKernel {
       const bool shade = p.kd > 0.f || p.ks > 0.f;
       const LightRay lr = lightRay(p.camera.eye, dir);
       const glm::vec3 ambient(p.ambient);
+      // For leaving an empty block: per axis the face ahead (upper for d > 0) and 1 / d.
+      glm::vec3 invD(0.f);
+      glm::ivec3 ahead(0);
+      for (int a = 0; a < 3; ++a) {
+        const bool moves = d[a] > 1e-20f || d[a] < -1e-20f;
+        invD[a] = moves ? 1.f / d[a] : 0.f;
+        ahead[a] = d[a] > 0.f ? 1 : 0;
+      }
       for (int s = 0; s < count && transmittance > p.earlyStop; ++s) {
         const float t = t0 + (float(s) + offset) * seg;
         const glm::vec3 idx = o + t * d;
+        if (p.skip.valid()) {
+          const glm::ivec3 b = glm::ivec3(glm::max(idx, glm::vec3(0.f))) / kRaySkipBlock;
+          const glm::ivec3 bc = glm::min(b, p.skip.dims - 1);
+          if (p.skip.empty[(int64_t(bc.z) * p.skip.dims.y + bc.y) * p.skip.dims.x + bc.x]) {
+            // Jump to the first sample at or past the block's exit face.
+            float tExit = 3.0e38f;
+            for (int a = 0; a < 3; ++a) {
+              if (invD[a] == 0.f) continue;
+              const float face = float((bc[a] + ahead[a]) * kRaySkipBlock);
+              const float ta = (face - o[a]) * invD[a];
+              tExit = ta < tExit ? ta : tExit;
+            }
+            const float next = ceilf((tExit - t0) / seg - offset);
+            s = next > float(s + 1) ? (next < float(count) ? int(next) : count) - 1 : s;
+            continue;
+          }
+        }
         ++samples;
-        const RayStencil<T> stencil(scalars, dims, idx);
-        float c[8];
-        stencil.corners(c);
-        const float value = stencil.value(c);
+        RayVoxels<T> voxels(scalars, dims, idx);
+        const float value = voxels.value();
         const TransferLookup::Entry entry = p.transfer.locate(value);
-        const float mu =
+        float mu =
             p.extinction.valid() ? raySample(p.extinction, idx) : p.transfer.extinction(entry);
+        if (method == RayMethod::CutAway || method == RayMethod::Transparency) {
+          const float gh = fminf(fmaxf(p.surf.importanceBehind.sample(idx), 0.f), 1.f);
+          mu = method == RayMethod::CutAway ? (gh > p.surf.cutThreshold ? 0.f : mu)
+                                            : mu * (1.f - gh);
+        }
         const float opticalDepth = mu * seg;
-        if (opticalDepth < 1e-7f) continue;
+        if (opticalDepth < kRayMinOpticalDepth) continue;
         const float alpha = raySegmentAlpha(opticalDepth);
         const glm::vec3 albedo = p.transfer.albedo(entry);
 
         // Direction and distance to the light from x = eye + t dir.
         const glm::vec3 fromLight = lr.e + t * dir;
-        const float dist = sqrtf(glm::dot(fromLight, fromLight));
-        const glm::vec3 toLight = fromLight * (-1.f / dist);
+        const float dist2 = glm::dot(fromLight, fromLight);
+        const float invDist = rayRsqrt(dist2);
+        const float dist = dist2 * invDist;
+        const glm::vec3 toLight = fromLight * -invDist;
 
         // Phase function: HG blended with Blinn-Phong about the gradient.
         float phase = phaseHG(glm::dot(toLight, dir));
@@ -225,33 +347,57 @@ struct RayMarchKernel {
         // Gradient shading only where the sample can still be seen: below that its effect on
         // the pixel is under 1e-4 of the light's radiance.
         if (shade && transmittance * alpha > 1e-4f) {
-          const glm::vec3 g2 = stencil.gradient2(c);  // twice the per-voxel gradient
-          const float perVoxel = 0.5f * glm::length(g2);
-          const float weight = fminf(perVoxel / p.surfaceGradient, 1.f);
+          const glm::vec3 g2 = voxels.gradient2();  // twice the per-voxel gradient
+          const float g2Length2 = glm::dot(g2, g2);
+          // weight = |g| / surfaceGradient, capped at 1 (|g| = |g2| / 2 per voxel).
+          const float ratio = g2Length2 * rayRsqrt(g2Length2) * halfInvSurfaceGradient;
+          const float weight = g2Length2 > 0.f ? (ratio < 1.f ? ratio : 1.f) : 0.f;
           surfaceWeight = weight;
           if (weight > 0.f) {
-            glm::vec3 n = glm::normalize(gradientToWorld * g2);
+            const glm::vec3 gw = gradientToWorld * g2;
+            glm::vec3 n = gw * rayRsqrt(glm::dot(gw, gw));
             if (glm::dot(n, toEye) < 0.f) n = -n;  // two-sided
             const float cosL = glm::dot(n, toLight);
             float bp = 0.f;
             if (cosL > 0.f) {
               float lobe = kdNorm;
               if (ksNorm > 0.f) {
-                const glm::vec3 half = glm::normalize(toLight + toEye);
-                lobe += ksNorm * rayPowUnit(fmaxf(glm::dot(n, half), 0.f), p.shininess);
+                const glm::vec3 sum = toLight + toEye;
+                const glm::vec3 half = sum * rayRsqrt(glm::dot(sum, sum));
+                const float cosH = glm::dot(n, half);
+                lobe += ksNorm * rayPowUnit(cosH > 0.f ? cosH : 0.f, p.shininess, shininessInt);
               }
               bp = lobe * cosL;
             }
             phase = (1.f - weight) * phase + weight * bp;
           }
         }
-        const float lightT = lightTransmittanceAt(lr, t, dist, p.camera.eye + t * dir, toLight,
-                                                  surfaceWeight);
-        radiance += transmittance * alpha * albedo * (phase * lightT * p.lightRadiance + ambient);
+        const float lightT =
+            lightTransmittanceAt(lr, t, dist, p.camera.eye + t * dir, toLight, surfaceWeight);
+        const glm::vec3 scattered = albedo * (phase * lightT * p.lightRadiance + ambient);
+        if (method == RayMethod::MaxImportance) {
+          const float g = p.surf.importance.sample(idx);
+          if (g > bestG) {
+            bestG = g;
+            bestColour = scattered;
+          }
+        }
+        // Transparency modulation: the surface sits at hit.t; blend it in when passing it.
+        if (surfaceAlpha > 0.f && method == RayMethod::Transparency && t > hit.t) {
+          radiance += transmittance * surfaceAlpha * surfaceColour;
+          transmittance *= 1.f - surfaceAlpha;
+          surfaceAlpha = 0.f;
+        }
+        radiance += transmittance * alpha * scattered;
         transmittance *= 1.f - alpha;
       }
     }
+    if (surfaceAlpha > 0.f) {  // the surface ends the ray (or was not passed by a sample)
+      radiance += transmittance * surfaceAlpha * surfaceColour;
+      transmittance *= 1.f - surfaceAlpha;
+    }
     radiance += transmittance * p.background;
+    if (method == RayMethod::MaxImportance && bestG > 0.05f) radiance = bestColour;
     p.pixels[pixel] = radiance;
     return samples;
   }

@@ -16,6 +16,7 @@
 #include "core/frustum_map.h"
 #include "core/hd.h"
 #include "kernels/ray_box.h"
+#include "kernels/surface_set.h"
 
 namespace visopt {
 
@@ -27,6 +28,7 @@ struct TransmittanceScan {
   FieldView out;  // dims == frustum.dims
   ExtinctionAt extinction;
   bool midpoint = true;
+  SurfaceSet surfaces;  // opaque: from the first cell centre inside one, T = 0
 
   VISOPT_HD void operator()(int64_t ray) const {
     const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
@@ -35,7 +37,16 @@ struct TransmittanceScan {
     const glm::vec3 d = volume.directionToIndex(dir);
     const RayInterval box = intersectBox(o, d, glm::vec3(volume.dims - 1));
     float opticalDepth = 0.f;
+    bool blocked = false;
     for (int k = 0; k < frustum.dims.z; ++k) {
+      if (!surfaces.empty() && !blocked && !box.empty()) {
+        const float s = frustum.depthOf(float(k));
+        blocked = s >= box.t0 && s <= box.t1 && surfaces.unionAt(o + s * d) < 0.f;
+      }
+      if (blocked) {
+        out.store(out.index(i, j, k), 0.f);
+        continue;
+      }
       float tau = 0.f;
       if (!box.empty()) {
         const float a = fmaxf(frustum.depthOf(float(k)) - 0.5f * frustum.ds, box.t0);

@@ -7,6 +7,8 @@
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "kernels/ray_march.h"
+#include "kernels/surface_render.h"
+#include "kernels/ray_skip.h"
 #include "kernels/transmittance_scan.h"
 #include "kernels/volume_extinction.h"
 #include "visopt/error.h"
@@ -46,6 +48,53 @@ Image upscale(const Image& small, int width, int height) {
   return out;
 }
 
+// The empty-block grid of kernels/ray_skip.h for marching with segments of at most `step`, or
+// an invalid grid when nothing can be skipped: the transfer function has no transparent range
+// and mu is not an optimised field.
+struct SkipGridStorage {
+  DeviceBuffer<glm::vec2> range;
+  DeviceBuffer<int> nonEmptyBefore;
+  DeviceBuffer<uint8_t> empty;
+  RaySkipGrid grid;
+};
+
+void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
+  // Extinction at or below this leaves every segment's optical depth under the marcher's
+  // threshold (with a margin for rounding in the interpolations and the segment length).
+  const float negligible = kRayMinOpticalDepth / (step * 1.001f);
+  RaySkipFlags flags;
+  if (!scene.extinction) {
+    const DeviceBuffer<glm::vec4>& table = *scene.transfer;
+    out.nonEmptyBefore = DeviceBuffer<int>(table.size() + 1);
+    int count = 0;
+    for (size_t i = 0; i < table.size(); ++i) {
+      out.nonEmptyBefore[i] = count;
+      if (!(table[i].w < negligible)) ++count;
+    }
+    out.nonEmptyBefore[table.size()] = count;
+    if (count == int(table.size())) return;  // nothing transparent
+    flags.nonEmptyBefore = out.nonEmptyBefore.data();
+    flags.tableSize = int(table.size());
+  } else {
+    // mu is sampled at the volume's index coordinates: only a field on the volume's grid.
+    if (scene.extinction->grid().dims != scene.volume->grid().dims) return;
+    flags.maxNegligibleExtinction = negligible * 0.999f;
+  }
+  const FieldView field =
+      scene.extinction ? FieldView(*scene.extinction) : FieldView(scene.volume->normalized);
+  const glm::ivec3 blocks = raySkipBlocks(field.dims);
+  const int64_t n = int64_t(blocks.x) * blocks.y * blocks.z;
+  out.range = DeviceBuffer<glm::vec2>(size_t(n));
+  out.empty = DeviceBuffer<uint8_t>(size_t(n));
+  exec::parallelFor("render skip ranges", n, RaySkipRange{field, blocks, out.range.data()});
+  flags.blocks = blocks;
+  flags.range = out.range.data();
+  flags.empty = out.empty.data();
+  exec::parallelFor("render skip flags", n, flags);
+  out.grid.empty = out.empty.data();
+  out.grid.dims = blocks;
+}
+
 }  // namespace
 
 void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
@@ -53,7 +102,9 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
   if (out.grid().dims != lightFrustum.dims)
     throw Error(ErrorKind::Failure, "light transmittance field does not match its frustum");
   TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum), GridMap(scene.volume->grid()),
-                                           FieldView(out), extinctionOf(scene), true};
+                                           FieldView(out), extinctionOf(scene), true, {}};
+  for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i)
+    scan.surfaces.phi[scan.surfaces.count++] = FieldView(*scene.surfaces[i]);
   exec::parallelFor("light transmittance", int64_t(lightFrustum.dims.x) * lightFrustum.dims.y,
                     scan);
 }
@@ -93,13 +144,39 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   p.ambient = settings.ambient;
   p.background = settings.background;
   p.earlyStop = settings.earlyStop;
+  // Context surfaces and the baselines' inputs.
+  for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i) {
+    const int k = p.surf.surfaces.count++;
+    p.surf.surfaces.phi[k] = FieldView(*scene.surfaces[i]);
+    if (i < scene.surfaceBases.size()) p.surf.bases[k] = FieldView(*scene.surfaceBases[i]);
+    p.surf.colors[k] = i < scene.surfaceColors.size() ? scene.surfaceColors[i] : glm::vec3(0.8f);
+  }
+  p.surf.deviationView = settings.deviationView;
+  p.surf.deviationScale = 1.f / (grid.minSpacing() * std::max(settings.deviationMaxVoxels, 1e-3f));
+  p.surf.ks = settings.surfaceSpecular;
+  p.surf.shininess = settings.surfaceShininess;
+  p.surf.ambientOcclusion = settings.ambientOcclusion;
+  p.surf.aoRadius = settings.ambientOcclusionRadius * grid.minSpacing();
+  p.surf.minStep = 0.25f * grid.minSpacing();
+  p.surf.method = static_cast<RayMethod>(static_cast<int>(settings.method));
+  if (settings.method != RenderMethod::Optimized &&
+      (!scene.importanceBehind || !scene.importance))
+    throw Error(ErrorKind::Usage, std::string("the ") + toString(settings.method) +
+                                      " baseline needs an importance and a view (run an "
+                                      "optimisation step first)");
+  if (scene.importanceBehind) p.surf.importanceBehind = FieldView(*scene.importanceBehind);
+  if (scene.importance) p.surf.importance = FieldView(*scene.importance);
+  p.surf.cutThreshold = settings.cutAwayThreshold;
+
+  SkipGridStorage skip;
+  buildSkipGrid(scene, p.step, skip);
+  p.skip = skip.grid;
 
   DeviceBuffer<glm::vec3> pixels(size_t(w) * size_t(h));
   p.pixels = pixels.data();
   const RayMarchKernel kernel(p);
-  const int64_t samples = exec::reduce(
-      "render", rayMarchItems(w, h), int64_t(0), kernel,
-      [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+  const int64_t samples = exec::reduce("render", rayMarchItems(w, h), int64_t(0), kernel,
+                                       [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
 
   Image image(w, h);
   for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = pixels[i] * settings.exposure;

@@ -1,6 +1,8 @@
 // The renderer's host side: builds kernel parameters from the scene and launches them.
 #pragma once
 
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "core/device_buffer.h"
@@ -15,12 +17,18 @@ namespace visopt {
 
 struct RenderScene {
   const Volume* volume = nullptr;
-  const Field3D* extinction = nullptr;           // optimised mu, or null for mu_bar
+  const Field3D* extinction = nullptr;                // optimised mu, or null for mu_bar
   const DeviceBuffer<glm::vec4>* transfer = nullptr;  // baked table (albedo, extinction)
   Camera camera;
   PointLight light;
   const FrustumGrid* lightFrustum = nullptr;  // with lightTransmittance, or both null
   const Field3D* lightTransmittance = nullptr;
+  // Context surfaces to draw (the visible ones): current phi, base phi0, colour.
+  std::vector<const Field3D*> surfaces, surfaceBases;
+  std::vector<glm::vec3> surfaceColors;
+  // For the comparison baselines: ghat (Eq. 19) and g on the volume grid.
+  const Field3D* importanceBehind = nullptr;
+  const Field3D* importance = nullptr;
 };
 
 // T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h).

@@ -14,6 +14,7 @@ Runner addInfoCommand(CLI::App& app);
 Runner addScenesCommand(CLI::App& app);
 Runner addRenderCommand(CLI::App& app);
 Runner addOptimizeCommand(CLI::App& app);
+Runner addCompareCommand(CLI::App& app);
 Runner addSdfCommand(CLI::App& app);
 Runner addSessionInfoCommand(CLI::App& app);
 

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   add(addScenesCommand, "scenes", "List the built-in scenes");
   add(addRenderCommand, "render", "Render a volume or built-in scene to a PNG");
   add(addOptimizeCommand, "optimize", "Optimise the extinction so the important parts show");
+  add(addCompareCommand, "compare", "The four methods of Fig. 10 side by side");
   add(addSdfCommand, "sdf", "Convert a triangle mesh to a signed distance field (.vdb)");
   add(addSessionInfoCommand, "session-info", "Describe a session file and check its data files");
 

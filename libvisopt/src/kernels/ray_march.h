@@ -272,7 +272,7 @@ struct RayMarchKernel {
       surfaceAlpha = 1.f;
       if (method == RayMethod::Transparency)
         surfaceAlpha = 1.f - fminf(fmaxf(p.surf.importanceBehind.sample(hidx), 0.f), 1.f);
-      else
+      else if (method != RayMethod::MaxImportance)  // the projection looks through everything
         t1 = hit.t;
     }
     // Maximum importance projection: the most important sample's colour.
@@ -325,9 +325,12 @@ struct RayMarchKernel {
         float mu =
             p.extinction.valid() ? raySample(p.extinction, idx) : p.transfer.extinction(entry);
         if (method == RayMethod::CutAway || method == RayMethod::Transparency) {
+          // Occluders in front of important structures go (cut-away) or fade (transparency
+          // modulation); the important structures themselves stay.
           const float gh = fminf(fmaxf(p.surf.importanceBehind.sample(idx), 0.f), 1.f);
-          mu = method == RayMethod::CutAway ? (gh > p.surf.cutThreshold ? 0.f : mu)
-                                            : mu * (1.f - gh);
+          const float occluder = gh * (1.f - fminf(fmaxf(p.surf.importance.sample(idx), 0.f), 1.f));
+          mu = method == RayMethod::CutAway ? (occluder > p.surf.cutThreshold ? 0.f : mu)
+                                            : mu * (1.f - occluder);
         }
         const float opticalDepth = mu * seg;
         if (opticalDepth < kRayMinOpticalDepth) continue;

@@ -157,7 +157,7 @@ TEST(ExtinctionOptimization, WarmStartFollowsTheCameraAndFreezingKeepsMu) {
 // thin-disc test above shows the literal V above 0.8 where the structure is optically thin.)
 TEST(ExtinctionOptimization, TumoursOfTheDefaultSceneComeIntoView) {
   Engine e;
-  e.loadBuiltinScene(defaultSceneName(), 64);
+  e.loadBuiltinScene(defaultSceneName(), 64, /*contextSurfaces=*/false);  // the skull in the volume
   e.setViewportSize(96, 96);
   ExtinctionSettings s;
   s.levels = 2;

@@ -200,6 +200,25 @@ void resample(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   });
 }
 
+// Restriction of an SDF to a coarser grid: the minimum over 3^3 points spread over each coarse
+// voxel, so a surface thinner than a coarse voxel (a skull, a thin shell) does not vanish from
+// the coarse levels, where it would otherwise let the view through.
+void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
+  const FieldView from(src), to(dst);
+  const GridMap map(dst.grid());
+  exec::parallelFor("multigrid restrict sdf", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
+    const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+              k = int(v / (int64_t(map.dims.x) * map.dims.y));
+    float m = 3.0e38f;
+    for (int c = 0; c < 27; ++c) {
+      const glm::vec3 off(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
+      const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)) + off / 3.f);
+      m = fminf(m, from.sample(srcMap.toIndex(x)));
+    }
+    to.store(size_t(v), m);
+  });
+}
+
 float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s, Precision p) {
   float m = s.muMax > 0.f ? s.muMax : in.transferMaxExtinction;
   if (!(m > 0.f)) m = 1.f;
@@ -275,7 +294,7 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     const Field3D& base = *in.surfaceBases[si];
     if (!next->finest) {
       next->phi0.emplace_back("surface-base (coarse)", grid, precision_, ledger_);
-      resample(base, fineMap, next->phi0.back());
+      restrictSdf(base, fineMap, next->phi0.back());
     }
     next->phi.emplace_back("surface", grid, precision_, ledger_);
     if (level_ && si < level_->phi.size())

@@ -1,5 +1,6 @@
 #include "io/file_util.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -169,6 +170,10 @@ std::string makeTemporarySibling(const std::string& path, const std::string& suf
   if (fd < 0)
     throw Error(ErrorKind::Failure,
                 path + ": cannot create a temporary file next to it: " + std::strerror(errno));
+  // mkstemp creates rw-------; an output file gets the usual rw-r--r-- less the umask.
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::fchmod(fd, 0666 & ~mask);
   ::close(fd);
   return std::string(name.data());
 }

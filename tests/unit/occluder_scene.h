@@ -11,7 +11,7 @@ namespace visopt::testing {
 struct OccluderScene {
   static constexpr float kSlabValue = 1.f, kBlobValue = 0.5f;
   int n = 40;
-  float slabY0 = -12.f, slabY1 = -2.f;      // the occluding slab, across x and z
+  float slabY0 = -12.f, slabY1 = -2.f;  // the occluding slab, across x and z
   // The important structure: a thin disc facing the camera. The energy raises mu inside
   // important structures up to mu_max (Eq. 12 rewards g mu T), so only an optically thin one can
   // reach a high importance-weighted visibility V = ∫ g mu T / ∫ g mu.
@@ -52,7 +52,8 @@ inline TransferFunction occluderTransferFunction() {
   tf.name = "occluder";
   tf.unitDistance = 1.f;
   auto alpha = [](float mu) { return 1.f - std::exp(-mu); };
-  tf.opacity = {{0.0, 0.f}, {0.25, 0.f}, {0.5, alpha(0.02f)}, {0.75, alpha(0.02f)}, {1.0, alpha(0.3f)}};
+  tf.opacity = {
+      {0.0, 0.f}, {0.25, 0.f}, {0.5, alpha(0.02f)}, {0.75, alpha(0.02f)}, {1.0, alpha(0.3f)}};
   tf.color = {{0.0, glm::vec3(0.8f)}, {0.5, glm::vec3(0.9f, 0.2f, 0.1f)}, {1.0, glm::vec3(0.8f)}};
   return tf;
 }

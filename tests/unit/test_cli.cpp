@@ -26,7 +26,8 @@ Result run(const std::string& args) {
   // ctest runs the tests of this file as parallel processes: one stderr file per call.
   static int calls = 0;
   const std::string errFile =
-      (dir / ("stderr-" + std::to_string(getpid()) + "-" + std::to_string(calls++) + ".txt")).string();
+      (dir / ("stderr-" + std::to_string(getpid()) + "-" + std::to_string(calls++) + ".txt"))
+          .string();
   const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
   Result r;
   FILE* pipe = popen(cmd.c_str(), "r");
@@ -67,7 +68,9 @@ TEST(Cli, ScenesListsTheDefault) {
 TEST(Cli, RenderWritesPngAndReportsStagesAndLedger) {
   const std::string out = tmp("render.png");
   fs::remove(out);
-  Result r = run("render --scene builtin:marschner-lobb --resolution 32 --size 48x40 --precision fp16 --out " + out + " --json");
+  Result r = run(
+      "render --scene builtin:marschner-lobb --resolution 32 --size 48x40 --precision fp16 --out " +
+      out + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);  // exactly one JSON object
   EXPECT_EQ(j["image"]["width"], 48);
@@ -77,7 +80,8 @@ TEST(Cli, RenderWritesPngAndReportsStagesAndLedger) {
   EXPECT_TRUE(hasRender);
   bool volumeFp16 = false;
   for (const auto& f : j["memory"]["fields"])
-    if (f["name"] == "volume") volumeFp16 = f["precision"] == "fp16" && f["bytes"] == 32 * 32 * 32 * 2;
+    if (f["name"] == "volume")
+      volumeFp16 = f["precision"] == "fp16" && f["bytes"] == 32 * 32 * 32 * 2;
   EXPECT_TRUE(volumeFp16);
   EXPECT_TRUE(fs::exists(out));
 }
@@ -87,7 +91,8 @@ TEST(Cli, UsageErrorsExitOne) {
   EXPECT_EQ(run("render --out x.png").code, 1);  // neither --volume nor --scene
   EXPECT_EQ(run("render --scene builtin:nope --out " + tmp("x.png")).code, 1);
   EXPECT_EQ(run("render --scene builtin:shepp-logan --size 0x5 --out " + tmp("x.png")).code, 1);
-  EXPECT_EQ(run("render --scene builtin:shepp-logan --precision fp8 --out " + tmp("x.png")).code, 1);
+  EXPECT_EQ(run("render --scene builtin:shepp-logan --precision fp8 --out " + tmp("x.png")).code,
+            1);
   EXPECT_EQ(run("optimize --scene builtin:shepp-logan --optimizer sgd").code, 1);
 }
 
@@ -114,13 +119,16 @@ TEST(Cli, BadInputExitsTwoWithOneLineNamingTheFile) {
 
 TEST(Cli, OptimizeReportsFallingEnergyAndRisingVisibility) {
   const std::string out = tmp("opt.png");
-  Result r = run("optimize --scene builtin:shepp-logan --resolution 48 --size 64x64 --levels 2 "
-                 "--iterations 30 --out " + out + " --json");
+  Result r =
+      run("optimize --scene builtin:shepp-logan --resolution 48 --size 64x64 --levels 2 "
+          "--iterations 30 --out " +
+          out + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   ASSERT_GT(j["iterations"].size(), 10u);
   EXPECT_LT(j["final"]["energy"].get<double>(), j["initial"]["energy"].get<double>());
-  EXPECT_GT(j["final"]["visibility_view"].get<double>(), j["initial"]["visibility_view"].get<double>());
+  EXPECT_GT(j["final"]["visibility_view"].get<double>(),
+            j["initial"]["visibility_view"].get<double>());
   EXPECT_TRUE(fs::exists(out));
   EXPECT_TRUE(fs::exists(tmp("opt-before.png")));
 }

@@ -89,7 +89,6 @@ TEST(ContextSurfaces, SurfaceOpensTowardsTheCamera) {
   EXPECT_GT(stats.back().visibilityView, 0.5) << "the blob must become visible";
   EXPECT_GT(capChange(e), kShell) << "the front cap must have left the shell's place";
   EXPECT_GT(stats.back().maxDeviationVoxels, 0.5) << "the rim of the hole has moved";
-
 }
 
 TEST(ContextSurfaces, SurfaceReturnsToItsBaseWhenTheImportanceIsRemoved) {

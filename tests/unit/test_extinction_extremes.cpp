@@ -48,7 +48,11 @@ std::vector<Extreme> extremes() {
       {"mu_max tiny", [](Engine&, ExtinctionSettings& s) { s.muMax = 1e-6f; }},
       {"mu_max huge", [](Engine&, ExtinctionSettings& s) { s.muMax = 1e6f; }},
       {"rho zero", [](Engine&, ExtinctionSettings& s) { s.rho = 0.f; }},
-      {"q and r huge", [](Engine&, ExtinctionSettings& s) { s.q = 1e6f; s.r = 1e6f; }},
+      {"q and r huge",
+       [](Engine&, ExtinctionSettings& s) {
+         s.q = 1e6f;
+         s.r = 1e6f;
+       }},
       {"g everywhere one",
        [](Engine& e, ExtinctionSettings& s) {
          e.setImportanceCurve({{0.0, 1.0}, {1.0, 1.0}});

@@ -46,7 +46,9 @@ FrustumGrid alignedFrustum(const GridSpec& g, float distance, int axis) {
   return f;
 }
 
-double energyAt(Problem& pr) { return evaluateProblem(pr.p, Precision::FP32).energy(); }
+double energyAt(Problem& pr) {
+  return evaluateProblem(pr.p, Precision::FP32).energy();
+}
 
 Problem makeProblem(glm::ivec3 dims, glm::vec3 spacing, uint32_t seed) {
   Problem pr;
@@ -113,7 +115,8 @@ TEST(ExtinctionGradient, EachTermAloneMatchesFiniteDifferences) {
       const double em = energyAt(pr);
       pr.mu.set(v, m);
       const double fd = (ep - em) / (2.0 * h);
-      EXPECT_NEAR(grad[v], fd, 3e-3 * std::max(1.0, std::abs(fd))) << "term " << term << " voxel " << v;
+      EXPECT_NEAR(grad[v], fd, 3e-3 * std::max(1.0, std::abs(fd)))
+          << "term " << term << " voxel " << v;
     }
   }
 }

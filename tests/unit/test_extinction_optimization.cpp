@@ -75,7 +75,8 @@ TEST(ExtinctionOptimization, BlobBehindOccluderBecomesVisibleAndTheRestStays) {
         const size_t idx = v.grid().linearIndex(i, j, k);
         if (lateral > scene.blobRadius + 6.f) {
           ++checked;
-          EXPECT_NEAR(mu.get(idx), base[idx], 0.05f * 0.5f) << "far voxel " << i << "," << j << "," << k;
+          EXPECT_NEAR(mu.get(idx), base[idx], 0.05f * 0.5f)
+              << "far voxel " << i << "," << j << "," << k;
         } else if (lateral < scene.blobRadius - 1.f && mu.get(idx) < 0.2f * base[idx]) {
           ++opened;
         }

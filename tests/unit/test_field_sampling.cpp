@@ -74,8 +74,9 @@ TEST(Exec, ParallelForReduceAndNamedTimings) {
   std::vector<int> hits(10000, 0);
   int* p = hits.data();
   exec::parallelFor("test-fill", 10000, [=](int64_t i) { p[i] += int(i % 7); });
-  long long sum = exec::reduce("test-sum", 10000, 0LL, [=](int64_t i) { return (long long)p[i]; },
-                               [](long long a, long long b) { return a + b; });
+  long long sum = exec::reduce(
+      "test-sum", 10000, 0LL, [=](int64_t i) { return (long long)p[i]; },
+      [](long long a, long long b) { return a + b; });
   long long expected = 0;
   for (int i = 0; i < 10000; ++i) expected += i % 7;
   EXPECT_EQ(sum, expected);

@@ -87,8 +87,8 @@ TEST(FrustumGrid, RoundTripCameraAndLight) {
   for (FrustumGrid* f : {&v, &l}) {
     for (int n = 0; n < 200; ++n) {
       glm::vec3 x(b.lo + (b.hi - b.lo) * glm::vec3(float((n * 37) % 101) / 100.f,
-                                                    float((n * 53) % 97) / 96.f,
-                                                    float((n * 71) % 89) / 88.f));
+                                                   float((n * 53) % 97) / 96.f,
+                                                   float((n * 71) % 89) / 88.f));
       expectNear(f->toWorld(f->toGrid(x)), x, 2e-4f);
       glm::vec3 y(float(n % 30), float((n * 7) % 30), float((n * 13) % 40));
       expectNear(f->toGrid(f->toWorld(y)), y, 2e-3f);

@@ -14,8 +14,8 @@ namespace {
 struct Reference {
   double m1 = 0, m2 = 0, nu = 0;
   // The PyTorch reference's rules, with nu (not its root) as state.
-  double step(double g, int t, double b1, double b2, double b3, double alpha, double lr,
-              double eps, bool ademamix) {
+  double step(double g, int t, double b1, double b2, double b3, double alpha, double lr, double eps,
+              bool ademamix) {
     m1 = b1 * m1 + (1 - b1) * g;
     nu = b2 * nu + (1 - b2) * g * g;
     double num = m1 / (1 - std::pow(b1, t));

@@ -37,8 +37,10 @@ PrecisionRun run(Precision p) {
 TEST(Precision, Fp16MatchesFp32WithinStatedPsnrAndHalvesMemory) {
   const PrecisionRun a = run(Precision::FP32), b = run(Precision::FP16);
   const double before = psnr(a.before, b.before), after = psnr(a.after, b.after);
-  std::printf("fp16 vs fp32 PSNR: %.1f dB before, %.1f dB after optimisation; memory %zu vs %zu bytes (%.0f %%)\n",
-              before, after, b.bytes, a.bytes, 100.0 * double(b.bytes) / double(a.bytes));
+  std::printf(
+      "fp16 vs fp32 PSNR: %.1f dB before, %.1f dB after optimisation; memory %zu vs %zu bytes "
+      "(%.0f %%)\n",
+      before, after, b.bytes, a.bytes, 100.0 * double(b.bytes) / double(a.bytes));
   EXPECT_GT(before, 40.0) << "plain rendering: fp16 storage of normalised scalars and T_L";
   EXPECT_GT(after, 30.0) << "after 50 optimiser steps with fp16 moments and mu";
   EXPECT_LE(double(b.bytes), 0.6 * double(a.bytes));

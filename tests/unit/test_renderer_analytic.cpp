@@ -14,7 +14,9 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 
 // Head-on camera along +y through the cube's centre.
-Camera headOn(float distance) { return Camera::orbit({0, 0, 0}, 0.f, 0.f, distance); }
+Camera headOn(float distance) {
+  return Camera::orbit({0, 0, 0}, 0.f, 0.f, distance);
+}
 }  // namespace
 
 class RendererPrecision : public ::testing::TestWithParam<Precision> {};
@@ -69,7 +71,8 @@ TEST_P(RendererPrecision, SingleScatteringMatchesClosedFormWithinOnePercent) {
       const float phase = (1.f - g * g) / (4.f * kPi * d * std::sqrt(d));
       const float L = 32.f;
       for (int c = 0; c < 3; ++c) {
-        const float expected = albedo[c] * light.intensity * phase * (1.f - std::exp(-2.f * mu * L)) / 2.f;
+        const float expected =
+            albedo[c] * light.intensity * phase * (1.f - std::exp(-2.f * mu * L)) / 2.f;
         EXPECT_NEAR(img.at(10, 10)[c], expected, 0.01f * expected)
             << "g " << g << " mu " << mu << " channel " << c;
       }

@@ -21,9 +21,9 @@ Field3D sphereSdf(const GridSpec& g, glm::vec3 centre, float radius) {
   for (int k = 0; k < g.dims.z; ++k)
     for (int j = 0; j < g.dims.y; ++j)
       for (int i = 0; i < g.dims.x; ++i)
-        phi.set(g.linearIndex(i, j, k),
-                glm::length(g.indexToWorld(glm::vec3(float(i), float(j), float(k))) - centre) -
-                    radius);
+        phi.set(
+            g.linearIndex(i, j, k),
+            glm::length(g.indexToWorld(glm::vec3(float(i), float(j), float(k))) - centre) - radius);
   return phi;
 }
 
@@ -101,8 +101,9 @@ TEST(SurfaceRendering, VolumeBehindAnOpaqueSurfaceIsHidden) {
   for (int k = 0; k < 33; ++k)
     for (int j = 0; j < 33; ++j)
       for (int i = 0; i < 33; ++i)
-        v.normalized.set(g.linearIndex(i, j, k),
-                         g.indexToWorld(glm::vec3(float(i), float(j), float(k))).y > 11.f ? 1.f : 0.f);
+        v.normalized.set(
+            g.linearIndex(i, j, k),
+            g.indexToWorld(glm::vec3(float(i), float(j), float(k))).y > 11.f ? 1.f : 0.f);
   Engine f;
   sphereScene(f, 33, 10.f, glm::vec3(0.7f));
   const Field3D sphere = sphereSdf(g, glm::vec3(0.f), 10.f);
@@ -132,7 +133,8 @@ TEST(SurfaceRendering, DeviationViewColoursByTheBaseDistance) {
   // Unoptimised: the surface is phi0's zero set, so the deviation is 0: colormap(0), lit as the
   // Lambertian centre is.
   const glm::vec3 expected = deviationColor(0.f) * 3.f / kPi;
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.at(16, 16)[c], expected[c], 0.03f * expected[c] + 1e-3f);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(img.at(16, 16)[c], expected[c], 0.03f * expected[c] + 1e-3f);
 }
 
 TEST(SurfaceRendering, TheFourMethodsDiffer) {

@@ -47,7 +47,8 @@ Runner addCompareCommand(CLI::App& app) {
     if (!o->camera.empty()) {
       glm::vec3 c = parseTriple(o->camera, "--camera");
       engine.orbitCamera(c.x, c.y, c.z);
-      engine.setLight(PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));
+      engine.setLight(
+          PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));
     }
     const glm::ivec2 size = parseSize(o->size);
     engine.setViewportSize(size.x, size.y);
@@ -77,10 +78,11 @@ Runner addCompareCommand(CLI::App& app) {
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (o->json)
-      std::printf("%s\n", nlohmann::json{{"command", "compare"}, {"out", o->out}, {"panels", order},
-                                         {"total_ms", ms}}
-                              .dump(2)
-                              .c_str());
+      std::printf("%s\n",
+                  nlohmann::json{
+                      {"command", "compare"}, {"out", o->out}, {"panels", order}, {"total_ms", ms}}
+                      .dump(2)
+                      .c_str());
     else
       std::printf("wrote %s: %s | %s | %s | %s\n", o->out.c_str(), toString(methods[0]),
                   toString(methods[1]), toString(methods[2]), toString(methods[3]));

@@ -56,7 +56,8 @@ Runner addScenesCommand(CLI::App& app) {
     if (*json) {
       nlohmann::json list = nlohmann::json::array();
       for (const auto& s : builtinScenes())
-        list.push_back({{"name", "builtin:" + s.name}, {"description", s.description},
+        list.push_back({{"name", "builtin:" + s.name},
+                        {"description", s.description},
                         {"default", s.name == defaultSceneName()}});
       std::printf("%s\n", nlohmann::json{{"scenes", list}}.dump(2).c_str());
     } else {

@@ -17,7 +17,9 @@ namespace visopt::cli {
 namespace {
 
 std::atomic<bool> interrupted{false};
-void onInterrupt(int) { interrupted = true; }
+void onInterrupt(int) {
+  interrupted = true;
+}
 
 double msSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -54,8 +56,8 @@ std::string beforePath(const std::string& out) {
 
 Runner addOptimizeCommand(CLI::App& app) {
   struct Options {
-    std::string volume, scene, tf, importance, camera, light, viewFrom, size = "512x512",
-        precision = "fp32", optimizer = "ademamix", out, worldMask, lens;
+    std::string volume, scene, tf, importance, camera, light, viewFrom,
+        size = "512x512", precision = "fp32", optimizer = "ademamix", out, worldMask, lens;
     std::vector<std::string> contexts;
     float shell = -1.f, lambda = -1.f;
     int redistIterations = -1;
@@ -75,12 +77,14 @@ Runner addOptimizeCommand(CLI::App& app) {
                  "file on the same grid");
   app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST (degrees, degrees, bounding radii)");
   app.add_option("--light", o->light, "Point light on an orbit AZ,EL,DIST (default: key light)");
-  app.add_option("--rho", o->rho, "Weight of staying close to the transfer function (<0: 1/mu_max)");
+  app.add_option("--rho", o->rho,
+                 "Weight of staying close to the transfer function (<0: 1/mu_max)");
   app.add_option("--q", o->q, "Weight of seeing the important parts from the camera");
   app.add_option("--r", o->r, "Weight of lighting the important parts (0: no light grids)");
   app.add_option("--optimizer", o->optimizer, "ademamix (default) or adam");
   app.add_option("--lr", o->lr, "Learning rate in units of mu_max per step");
-  app.add_option("--mu-max", o->muMax, "Upper bound of the extinction (0: the transfer function's)");
+  app.add_option("--mu-max", o->muMax,
+                 "Upper bound of the extinction (0: the transfer function's)");
   app.add_option("--levels", o->levels, "Coarse-to-fine multigrid levels");
   app.add_option("--iterations", o->iterations, "Iteration cap per level");
   app.add_option("--tolerance", o->tolerance, "Relative energy change that ends a level");
@@ -92,8 +96,10 @@ Runner addOptimizeCommand(CLI::App& app) {
                                   "Context surfaces as thin shells reaching D (world units) to "
                                   "either side of the surface (Eq. 26)");
   app.add_flag("--filled", o->filled, "Context surfaces filled (the default)")->excludes(shellOpt);
-  app.add_option("--lambda", o->lambda, "How strongly surfaces return to their base shape (Eq. 23)");
-  app.add_option("--redist-iterations", o->redistIterations, "Redistancing iterations at most (Eq. 18)");
+  app.add_option("--lambda", o->lambda,
+                 "How strongly surfaces return to their base shape (Eq. 23)");
+  app.add_option("--redist-iterations", o->redistIterations,
+                 "Redistancing iterations at most (Eq. 18)");
   app.add_option("--world-mask", o->worldMask,
                  "Volume file on the data grid: non-zero voxels keep their context surface");
   app.add_option("--lens", o->lens,
@@ -102,8 +108,9 @@ Runner addOptimizeCommand(CLI::App& app) {
                "Colour surfaces by how far they moved from their base (|phi0| in voxels)");
   app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
   app.add_option("--size", o->size, "Image size WxH (the frustum grids follow it)");
-  app.add_option("--out", o->out, "Render the optimised view here (and the unoptimised one "
-                                  "next to it as NAME-before.png)");
+  app.add_option("--out", o->out,
+                 "Render the optimised view here (and the unoptimised one "
+                 "next to it as NAME-before.png)");
   app.add_option("--view-from", o->viewFrom,
                  "Also render the frozen result from this orbit AZ,EL,DIST (NAME-view.png)");
   app.add_flag("--json", o->json, "Print per-iteration statistics, stage times and memory as JSON");
@@ -190,7 +197,8 @@ Runner addOptimizeCommand(CLI::App& app) {
     auto stats = engine.optimize([&](const IterationStats& st) {
       if (!o->json && !o->quiet)
         std::fprintf(stderr,
-                     "level %d  iteration %3d  energy %+.5e  V_view %.3f (occluders %.3f)  V_light %.3f  step %.2e\n",
+                     "level %d  iteration %3d  energy %+.5e  V_view %.3f (occluders %.3f)  V_light "
+                     "%.3f  step %.2e\n",
                      st.level, st.iteration, st.energy(), st.visibilityView,
                      st.visibilityViewOccluders, st.visibilityLight, st.stepNorm);
       return !interrupted.load();
@@ -219,25 +227,32 @@ Runner addOptimizeCommand(CLI::App& app) {
     if (o->json) {
       nlohmann::json iterations = nlohmann::json::array();
       for (const auto& st : stats) iterations.push_back(statsJson(st));
-      nlohmann::json j = {
-          {"command", "optimize"},
-          {"backend", backendDescription()},
-          {"input", engine.volume().sourcePath},
-          {"precision", o->precision},
-          {"settings",
-           {{"rho", s.rho}, {"q", s.q}, {"r", s.r}, {"optimizer", toString(s.optimizer)},
-            {"learning_rate", s.learningRate}, {"levels", s.levels},
-            {"iterations_per_level", s.maxIterationsPerLevel}, {"tolerance", s.tolerance},
-            {"frustum_scale", s.frustumScale}}},
-          {"interrupted", interrupted.load()},
-          {"iterations", iterations},
-          {"final", stats.empty() ? nlohmann::json() : statsJson(stats.back())},
-          {"initial", stats.empty() ? nlohmann::json() : statsJson(stats.front())},
-          {"times_ms", {{"setup", setupMs}, {"optimize", optimizeMs}, {"render", renderMs},
-                        {"total", msSince(t0)}}},
-          {"stages", stageTimingsJson()},
-          {"images", images},
-          {"memory", ledgerJson(engine.ledger())}};
+      nlohmann::json j = {{"command", "optimize"},
+                          {"backend", backendDescription()},
+                          {"input", engine.volume().sourcePath},
+                          {"precision", o->precision},
+                          {"settings",
+                           {{"rho", s.rho},
+                            {"q", s.q},
+                            {"r", s.r},
+                            {"optimizer", toString(s.optimizer)},
+                            {"learning_rate", s.learningRate},
+                            {"levels", s.levels},
+                            {"iterations_per_level", s.maxIterationsPerLevel},
+                            {"tolerance", s.tolerance},
+                            {"frustum_scale", s.frustumScale}}},
+                          {"interrupted", interrupted.load()},
+                          {"iterations", iterations},
+                          {"final", stats.empty() ? nlohmann::json() : statsJson(stats.back())},
+                          {"initial", stats.empty() ? nlohmann::json() : statsJson(stats.front())},
+                          {"times_ms",
+                           {{"setup", setupMs},
+                            {"optimize", optimizeMs},
+                            {"render", renderMs},
+                            {"total", msSince(t0)}}},
+                          {"stages", stageTimingsJson()},
+                          {"images", images},
+                          {"memory", ledgerJson(engine.ledger())}};
       std::printf("%s\n", j.dump(2).c_str());
     } else if (!stats.empty()) {
       const auto& f = stats.back();

@@ -33,7 +33,8 @@ Runner addRenderCommand(CLI::App& app) {
       ->excludes(volumeOption)
       ->excludes(sceneOption);
   app.add_option("--resolution", o->resolution, "Built-in scene resolution (longest axis, voxels)");
-  app.add_option("--tf", o->tf, "Transfer function: a JSON file (visopt or ParaView) or preset:NAME");
+  app.add_option("--tf", o->tf,
+                 "Transfer function: a JSON file (visopt or ParaView) or preset:NAME");
   app.add_option("--size", o->size, "Image size WxH");
   app.add_option("--camera", o->camera,
                  "Orbit AZ,EL,DIST: degrees about +z, degrees above the xy-plane, distance in "
@@ -80,7 +81,8 @@ Runner addRenderCommand(CLI::App& app) {
       glm::vec3 c = parseTriple(o->camera, "--camera");
       if (!(c.z > 0.f)) throw Error(ErrorKind::Usage, "--camera: distance must be positive");
       engine.orbitCamera(c.x, c.y, c.z);
-      engine.setLight(PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));
+      engine.setLight(
+          PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));
     }
     RenderSettings settings = session ? session->render : RenderSettings{};
     if (!session || given("--size")) {
@@ -104,13 +106,20 @@ Runner addRenderCommand(CLI::App& app) {
           {"input", engine.volume().sourcePath},
           {"precision", toString(precision)},
           {"out", o->out},
-          {"image", {{"width", settings.width}, {"height", settings.height},
-                     {"rendered_width", stats.width}, {"rendered_height", stats.height}}},
-          {"times_ms", {{"load", loadMs}, {"light_transmittance", stats.lightMilliseconds},
-                        {"render", stats.milliseconds}, {"write_png", writeMs},
-                        {"total", msSince(t0)}}},
+          {"image",
+           {{"width", settings.width},
+            {"height", settings.height},
+            {"rendered_width", stats.width},
+            {"rendered_height", stats.height}}},
+          {"times_ms",
+           {{"load", loadMs},
+            {"light_transmittance", stats.lightMilliseconds},
+            {"render", stats.milliseconds},
+            {"write_png", writeMs},
+            {"total", msSince(t0)}}},
           {"samples", stats.samples},
-          {"samples_per_second", stats.milliseconds > 0 ? double(stats.samples) / (stats.milliseconds * 1e-3) : 0.0},
+          {"samples_per_second",
+           stats.milliseconds > 0 ? double(stats.samples) / (stats.milliseconds * 1e-3) : 0.0},
           {"stages", stageTimingsJson()},
           {"memory", ledgerJson(engine.ledger())}};
       if (session) j["session"] = {{"path", o->session}, {"data", sessionData}};

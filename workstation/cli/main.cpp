@@ -40,9 +40,12 @@ int main(int argc, char** argv) {
   } catch (const visopt::Error& e) {
     std::fprintf(stderr, "visopt: %s\n", e.what());
     switch (e.kind()) {
-      case visopt::ErrorKind::Usage: return kUsage;
-      case visopt::ErrorKind::BadInput: return kBadInput;
-      default: return kFailure;
+      case visopt::ErrorKind::Usage:
+        return kUsage;
+      case visopt::ErrorKind::BadInput:
+        return kBadInput;
+      default:
+        return kFailure;
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "visopt: %s\n", e.what());

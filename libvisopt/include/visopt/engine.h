@@ -55,7 +55,8 @@ class Engine {
 
   // ---- importance g(x) in [0, 1] (paper 000 §III-A) ----
   // A piecewise-linear curve over data values: points (value, g), g in [0, 1].
-  void setImportanceCurve(const std::vector<glm::dvec2>& points, const std::string& origin = "importance curve");
+  void setImportanceCurve(const std::vector<glm::dvec2>& points,
+                          const std::string& origin = "importance curve");
   // A JSON curve file ({"points": [[value, g], ...]} or a visopt transfer function whose opacity
   // is read as g) or a volume file on the same grid with values in [0, 1].
   void loadImportance(const std::string& path);
@@ -100,7 +101,8 @@ class Engine {
   // The frustum grids follow this image size (set it to the render size).
   void setViewportSize(int width, int height);
   // Coarse to fine from mu_bar. The callback sees every iteration; returning false stops.
-  std::vector<IterationStats> optimize(const std::function<bool(const IterationStats&)>& callback = {});
+  std::vector<IterationStats> optimize(
+      const std::function<bool(const IterationStats&)>& callback = {});
   // Continues at the finest level from the current mu, for the current camera and light (warm
   // start: what the workstation runs while the user navigates). Does nothing while frozen.
   std::vector<IterationStats> continueOptimization(
@@ -111,7 +113,8 @@ class Engine {
   void resetOptimization();
   bool hasOptimizedExtinction() const;
   const Field3D* optimizedExtinction() const;
-  // Render with the optimised mu (default when there is one) or with the transfer function's mu_bar.
+  // Render with the optimised mu (default when there is one) or with the transfer function's
+  // mu_bar.
   void setRenderOptimized(bool useOptimized);
 
   // Renders the current scene. T_L is recomputed only when the light, the transfer function,

@@ -8,10 +8,10 @@
 namespace visopt {
 
 enum class ErrorKind {
-  Usage,     // a caller asked for something that makes no sense (bad option, bad parameter)
-  BadInput,  // a file or value given by the user is unreadable, inconsistent or out of range
-  Cancelled, // the user cancelled long work
-  Failure,   // anything else: out of memory, a backend failure, a bug
+  Usage,      // a caller asked for something that makes no sense (bad option, bad parameter)
+  BadInput,   // a file or value given by the user is unreadable, inconsistent or out of range
+  Cancelled,  // the user cancelled long work
+  Failure,    // anything else: out of memory, a backend failure, a bug
 };
 
 class Error : public std::runtime_error {

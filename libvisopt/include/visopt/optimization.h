@@ -19,16 +19,16 @@ struct ExtinctionSettings {
   float muMax = 0.f;  // upper bound of Eq. 14 (1 / world unit); 0: the transfer function's maximum
 
   OptimizerKind optimizer = OptimizerKind::AdEMAMix;
-  float learningRate = 0.05f;  // in units of mu_max per step
+  float learningRate = 0.05f;                           // in units of mu_max per step
   float beta1 = 0.9f, beta2 = 0.999f, beta3 = 0.9999f;  // AdEMAMix; Adam uses beta1, beta2
-  float alpha = 5.f;           // AdEMAMix slow-EMA weight
+  float alpha = 5.f;                                    // AdEMAMix slow-EMA weight
   float epsilon = 1e-8f;
   // Warm-up lengths of AdEMAMix's alpha and beta3 schedulers; 0 = the level's iteration cap.
   int alphaWarmup = 0, beta3Warmup = 0;
 
-  int levels = 3;                 // coarse-to-fine multigrid levels
+  int levels = 3;  // coarse-to-fine multigrid levels
   int maxIterationsPerLevel = 60;
-  float tolerance = 1e-4f;        // relative energy change that ends a level
+  float tolerance = 1e-4f;  // relative energy change that ends a level
   int minIterationsPerLevel = 5;
 
   // View frustum grid: rays per side as a fraction of the image size at the finest level, and
@@ -55,12 +55,12 @@ struct IterationStats {
   // V with T_V taken through unimportant matter only: how much the occluders hide the important
   // structures, leaving out their own fronts (the energy raises mu inside them, Eq. 12).
   double visibilityViewOccluders = 0.0;
-  double stepNorm = 0.0;         // RMS of the change of mu over the voxels
-  double gridUpdatesMs = 0.0;    // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
-  double extinctionStepMs = 0.0; // gather, optimiser step, projection ("Ext. Opt.")
+  double stepNorm = 0.0;          // RMS of the change of mu over the voxels
+  double gridUpdatesMs = 0.0;     // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
+  double extinctionStepMs = 0.0;  // gather, optimiser step, projection ("Ext. Opt.")
   // Context surfaces (paper 000 Eqs. 18-23), when there are any.
-  double sdfStepMs = 0.0;         // ghat gather and the level-set step ("SDF Opt.")
-  double redistanceMs = 0.0;      // all redistancing iterations ("Redist." x iterations)
+  double sdfStepMs = 0.0;     // ghat gather and the level-set step ("SDF Opt.")
+  double redistanceMs = 0.0;  // all redistancing iterations ("Redist." x iterations)
   int redistanceIterations = 0;
   double redistanceResidual = 0.0;  // mean squared change of the last iteration (voxels^2)
   double levelSetTimeStep = 0.0;

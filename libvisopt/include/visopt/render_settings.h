@@ -9,10 +9,10 @@ namespace visopt {
 
 // The comparison baselines of paper 000 Fig. 10, and ours.
 enum class RenderMethod {
-  Optimized,               // ours: the optimised extinction and surfaces
-  MaxImportanceProjection, // each pixel shows the sample of highest importance (surfaces too)
-  CutAway,                 // surfaces and volume removed where ghat exceeds a threshold
-  TransparencyModulation,  // surfaces and volume made transparent in proportion to ghat
+  Optimized,                // ours: the optimised extinction and surfaces
+  MaxImportanceProjection,  // each pixel shows the sample of highest importance (surfaces too)
+  CutAway,                  // surfaces and volume removed where ghat exceeds a threshold
+  TransparencyModulation,   // surfaces and volume made transparent in proportion to ghat
 };
 const char* toString(RenderMethod method);
 

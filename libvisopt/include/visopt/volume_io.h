@@ -26,9 +26,9 @@ struct VolumeInfo {
   std::string scalarType;  // "uint8", "int16", "float32", ...
   GridSpec grid;
   double valueMin = 0.0, valueMax = 0.0;
-  size_t bytesOnDisk = 0;     // of the scalar payload, as stored
-  size_t bytesFp32 = 0;       // what visopt needs to hold the scalars as fp32
-  size_t bytesFp16 = 0;       // ... and as fp16
+  size_t bytesOnDisk = 0;  // of the scalar payload, as stored
+  size_t bytesFp32 = 0;    // what visopt needs to hold the scalars as fp32
+  size_t bytesFp16 = 0;    // ... and as fp16
 };
 
 // Reads the whole file (values are needed for the range) and describes it.

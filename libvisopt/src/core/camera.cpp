@@ -15,9 +15,9 @@ Camera Camera::orbit(glm::vec3 target, float azimuthDeg, float elevationDeg, flo
   c.target = target;
   c.eye = target + distance * dir;
   // Near the poles +z is (almost) parallel to the view direction; use the azimuth's forward.
-  c.up = std::abs(elevationDeg) > 89.f ? glm::vec3(-std::sin(az), std::cos(az), 0.f) *
-                                             (elevationDeg > 0 ? 1.f : -1.f)
-                                       : glm::vec3(0.f, 0.f, 1.f);
+  c.up = std::abs(elevationDeg) > 89.f
+             ? glm::vec3(-std::sin(az), std::cos(az), 0.f) * (elevationDeg > 0 ? 1.f : -1.f)
+             : glm::vec3(0.f, 0.f, 1.f);
   return c;
 }
 

@@ -14,7 +14,8 @@ class DeviceBuffer {
   DeviceBuffer() = default;
   explicit DeviceBuffer(size_t n) : n_(n), p_(static_cast<T*>(exec::allocate(n * sizeof(T)))) {}
   ~DeviceBuffer() { exec::deallocate(p_); }
-  DeviceBuffer(DeviceBuffer&& o) noexcept : n_(std::exchange(o.n_, 0)), p_(std::exchange(o.p_, nullptr)) {}
+  DeviceBuffer(DeviceBuffer&& o) noexcept
+      : n_(std::exchange(o.n_, 0)), p_(std::exchange(o.p_, nullptr)) {}
   DeviceBuffer& operator=(DeviceBuffer&& o) noexcept {
     std::swap(n_, o.n_);
     std::swap(p_, o.p_);

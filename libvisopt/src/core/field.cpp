@@ -17,7 +17,9 @@ Field3D::Field3D(std::string name, const GridSpec& grid, Precision precision, Me
   if (ledger_) ledgerToken_ = ledger_->add(name_, bytes(), toString(precision_));
 }
 
-Field3D::~Field3D() { release(); }
+Field3D::~Field3D() {
+  release();
+}
 
 void Field3D::release() {
   if (ledger_ && ledgerToken_) ledger_->remove(ledgerToken_);
@@ -27,8 +29,12 @@ void Field3D::release() {
 }
 
 Field3D::Field3D(Field3D&& o) noexcept
-    : name_(std::move(o.name_)), grid_(o.grid_), precision_(o.precision_), data_(o.data_),
-      ledger_(o.ledger_), ledgerToken_(o.ledgerToken_) {
+    : name_(std::move(o.name_)),
+      grid_(o.grid_),
+      precision_(o.precision_),
+      data_(o.data_),
+      ledger_(o.ledger_),
+      ledgerToken_(o.ledgerToken_) {
   o.data_ = nullptr;
   o.ledgerToken_ = 0;
 }
@@ -48,8 +54,12 @@ Field3D& Field3D::operator=(Field3D&& o) noexcept {
   return *this;
 }
 
-float Field3D::get(size_t i) const { return FieldView(*this).load(i); }
-void Field3D::set(size_t i, float v) { FieldView(*this).store(i, v); }
+float Field3D::get(size_t i) const {
+  return FieldView(*this).load(i);
+}
+void Field3D::set(size_t i, float v) {
+  FieldView(*this).store(i, v);
+}
 
 void Field3D::fill(float v) {
   FieldView view(*this);

@@ -24,7 +24,8 @@ struct FieldView {
   explicit FieldView(Field3D& f)
       : data(f.raw()), half(f.precision() == Precision::FP16), dims(f.grid().dims) {}
   explicit FieldView(const Field3D& f)
-      : data(const_cast<void*>(f.raw())), half(f.precision() == Precision::FP16),
+      : data(const_cast<void*>(f.raw())),
+        half(f.precision() == Precision::FP16),
         dims(f.grid().dims) {}
 
   VISOPT_HD bool valid() const { return data != nullptr; }
@@ -33,7 +34,8 @@ struct FieldView {
     return (size_t(k) * size_t(dims.y) + size_t(j)) * size_t(dims.x) + size_t(i);
   }
   VISOPT_HD VISOPT_INLINE float load(size_t i) const {
-    return half ? halfToFloat(static_cast<const Half*>(data)[i]) : static_cast<const float*>(data)[i];
+    return half ? halfToFloat(static_cast<const Half*>(data)[i])
+                : static_cast<const float*>(data)[i];
   }
   // fp16 stores saturate at +-65504 (fp16's largest finite value) rather than overflow to inf.
   VISOPT_HD void store(size_t i, float v) const {

@@ -27,8 +27,12 @@ void clipToSphere(FrustumGrid& f, const Bounds& bounds) {
 
 }  // namespace
 
-glm::vec3 FrustumGrid::toGrid(glm::vec3 world) const { return FrustumMap(*this).toGrid(world); }
-glm::vec3 FrustumGrid::toWorld(glm::vec3 grid) const { return FrustumMap(*this).toWorld(grid); }
+glm::vec3 FrustumGrid::toGrid(glm::vec3 world) const {
+  return FrustumMap(*this).toGrid(world);
+}
+glm::vec3 FrustumGrid::toWorld(glm::vec3 grid) const {
+  return FrustumMap(*this).toWorld(grid);
+}
 glm::vec3 FrustumGrid::rayDirection(float px, float py) const {
   return FrustumMap(*this).rayDirection(px, py);
 }
@@ -70,13 +74,13 @@ FrustumGrid FrustumGrid::forLight(const PointLight& light, const Bounds& bounds,
   f.up = glm::cross(f.right, f.forward);
   // Half-angle that holds the bounding sphere, with a 2 % margin; at most 80° when the light is
   // inside (or nearly inside) the sphere — points outside the frustum count as unshadowed.
-  float half = d > radius * 1.0001f ? std::asin(std::min(radius / d, 1.f)) * 1.02f
-                                    : 80.f * kDegToRad;
+  float half =
+      d > radius * 1.0001f ? std::asin(std::min(radius / d, 1.f)) * 1.02f : 80.f * kDegToRad;
   half = std::min(half, 80.f * kDegToRad);
   f.tanHalfFovX = f.tanHalfFovY = std::tan(half);
   clipToSphere(f, bounds);
-  f.dims = glm::ivec3(dims.x, dims.y,
-                      dims.z > 0 ? dims.z : autoDepthCells(f.sNear, f.sFar, voxelSize));
+  f.dims =
+      glm::ivec3(dims.x, dims.y, dims.z > 0 ? dims.z : autoDepthCells(f.sNear, f.sFar, voxelSize));
   return f;
 }
 

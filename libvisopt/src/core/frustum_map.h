@@ -36,8 +36,15 @@ struct FrustumMap {
 
   FrustumMap() = default;
   explicit FrustumMap(const FrustumGrid& f)
-      : eye(f.eye), right(f.right), up(f.up), forward(f.forward), tanX(f.tanHalfFovX),
-        tanY(f.tanHalfFovY), dims(f.dims), sNear(f.sNear), ds(f.depthStep()) {}
+      : eye(f.eye),
+        right(f.right),
+        up(f.up),
+        forward(f.forward),
+        tanX(f.tanHalfFovX),
+        tanY(f.tanHalfFovY),
+        dims(f.dims),
+        sNear(f.sNear),
+        ds(f.depthStep()) {}
 
   // Ray direction through continuous pixel coordinates (pixel centres at integers).
   VISOPT_HD glm::vec3 rayDirection(float px, float py) const {
@@ -53,8 +60,8 @@ struct FrustumMap {
     if (z <= 0.f) return glm::vec3(-1e30f);  // behind the eye: outside every frustum
     float u = glm::dot(d, right) / (z * tanX);
     float v = glm::dot(d, up) / (z * tanY);
-    return glm::vec3((u + 1.f) * 0.5f * float(dims.x) - 0.5f, (v + 1.f) * 0.5f * float(dims.y) - 0.5f,
-                     (s - sNear) / ds - 0.5f);
+    return glm::vec3((u + 1.f) * 0.5f * float(dims.x) - 0.5f,
+                     (v + 1.f) * 0.5f * float(dims.y) - 0.5f, (s - sNear) / ds - 0.5f);
   }
   // g^-1: continuous coordinates -> world.
   VISOPT_HD glm::vec3 toWorld(glm::vec3 y) const {

@@ -39,7 +39,8 @@ Field3D isoSurface(const std::string& spec, const Volume& volume, const LevelSet
     throw Error(ErrorKind::Usage, "context '" + spec + "': VALUE must be a number");
   }
   if (!std::isfinite(value) || value <= volume.valueMin || value >= volume.valueMax)
-    throw Error(ErrorKind::Usage, "context '" + spec + "': the isovalue must lie inside the data range (" +
+    throw Error(ErrorKind::Usage, "context '" + spec +
+                                      "': the isovalue must lie inside the data range (" +
                                       std::to_string(volume.valueMin) + " .. " +
                                       std::to_string(volume.valueMax) + ")");
   return sdfFromIsovalue(volume, value, insideHigh, ls, precision, ledger);

@@ -161,7 +161,9 @@ struct Engine::Impl {
 Engine::Engine(Precision precision) : impl_(std::make_unique<Impl>(precision)) {}
 Engine::~Engine() = default;
 
-Precision Engine::precision() const { return impl_->precision; }
+Precision Engine::precision() const {
+  return impl_->precision;
+}
 
 void Engine::loadVolume(const std::string& path, const ProgressCallback& progress) {
   impl_->clearScene();
@@ -182,8 +184,8 @@ void Engine::loadBuiltinScene(const std::string& name, int resolution, bool cont
     impl_->importance.emplace(importanceFromNormalizedCurve(*impl_->volume, scene.importanceCurve,
                                                             impl_->precision, &impl_->ledger));
   const bool withSurfaces = contextSurfaces && !scene.contextSurfaces.empty();
-  impl_->tf = withSurfaces ? std::move(scene.contextTransferFunction)
-                           : std::move(scene.transferFunction);
+  impl_->tf =
+      withSurfaces ? std::move(scene.contextTransferFunction) : std::move(scene.transferFunction);
   impl_->hasTf = true;
   impl_->invalidateAll();
   impl_->frameView(scene.azimuthDeg, scene.elevationDeg, scene.distanceInRadii);
@@ -199,7 +201,9 @@ void Engine::setVolume(Volume volume) {
   impl_->frameView(0.f, 10.f, 2.6f);
 }
 
-bool Engine::hasVolume() const { return impl_->volume.has_value(); }
+bool Engine::hasVolume() const {
+  return impl_->volume.has_value();
+}
 
 const Volume& Engine::volume() const {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
@@ -215,26 +219,33 @@ void Engine::setTransferFunction(TransferFunction tf) {
 
 const TransferFunction& Engine::transferFunction() const {
   if (!impl_->hasTf && impl_->volume) {
-    impl_->tf = TransferFunction::preset("generic", impl_->volume->valueMin, impl_->volume->valueMax);
+    impl_->tf =
+        TransferFunction::preset("generic", impl_->volume->valueMin, impl_->volume->valueMax);
     impl_->hasTf = true;
   }
   return impl_->tf;
 }
 
-void Engine::setCamera(const Camera& camera) { impl_->camera = camera; }
-const Camera& Engine::camera() const { return impl_->camera; }
+void Engine::setCamera(const Camera& camera) {
+  impl_->camera = camera;
+}
+const Camera& Engine::camera() const {
+  return impl_->camera;
+}
 
 void Engine::orbitCamera(float azimuthDeg, float elevationDeg, float distanceInRadii) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
-  impl_->camera = Camera::orbitBounds(impl_->volume->grid().worldBounds(), azimuthDeg,
-                                      elevationDeg, distanceInRadii);
+  impl_->camera = Camera::orbitBounds(impl_->volume->grid().worldBounds(), azimuthDeg, elevationDeg,
+                                      distanceInRadii);
 }
 
 void Engine::setLight(const PointLight& light) {
   impl_->light = light;
   impl_->lightDirty = true;
 }
-const PointLight& Engine::light() const { return impl_->light; }
+const PointLight& Engine::light() const {
+  return impl_->light;
+}
 
 Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
@@ -248,7 +259,9 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
   return image;
 }
 
-const MemoryLedger& Engine::ledger() const { return impl_->ledger; }
+const MemoryLedger& Engine::ledger() const {
+  return impl_->ledger;
+}
 
 int Engine::addContextSurface(const ContextSurfaceSpec& spec, const ProgressCallback& progress) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its context surfaces");
@@ -307,8 +320,12 @@ const Field3D* Engine::contextSurfaceBase(int index) const {
   return &impl_->surfaceBases[size_t(index)];
 }
 
-void Engine::setLevelSetSettings(const LevelSetSettings& settings) { impl_->levelSet = settings; }
-const LevelSetSettings& Engine::levelSetSettings() const { return impl_->levelSet; }
+void Engine::setLevelSetSettings(const LevelSetSettings& settings) {
+  impl_->levelSet = settings;
+}
+const LevelSetSettings& Engine::levelSetSettings() const {
+  return impl_->levelSet;
+}
 
 void Engine::loadWorldMask(const std::string& path) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before a mask");
@@ -330,7 +347,9 @@ void Engine::setWorldMask(Field3D mask) {
   for (size_t i = 0; i < mask.size(); ++i) impl_->worldMask->set(i, mask.get(i));
 }
 
-void Engine::clearWorldMask() { impl_->worldMask.reset(); }
+void Engine::clearWorldMask() {
+  impl_->worldMask.reset();
+}
 const Field3D* Engine::worldMask() const {
   return impl_->worldMask ? &*impl_->worldMask : nullptr;
 }
@@ -341,15 +360,19 @@ void Engine::setLens(const ImportanceLens& lens) {
     throw Error(ErrorKind::Usage, "the lens needs a finite position, radius >= 0, strength >= 0");
   impl_->lens = lens;
 }
-const ImportanceLens& Engine::lens() const { return impl_->lens; }
+const ImportanceLens& Engine::lens() const {
+  return impl_->lens;
+}
 
-const Field3D* Engine::importanceBehind() const { return impl_->optimizer.importanceBehind(); }
+const Field3D* Engine::importanceBehind() const {
+  return impl_->optimizer.importanceBehind();
+}
 
 void Engine::setImportanceCurve(const std::vector<glm::dvec2>& points, const std::string& origin) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its importance");
   impl_->importance.reset();
-  impl_->importance.emplace(importanceFromCurve(*impl_->volume, points, origin, impl_->precision,
-                                                &impl_->ledger));
+  impl_->importance.emplace(
+      importanceFromCurve(*impl_->volume, points, origin, impl_->precision, &impl_->ledger));
   impl_->importanceSource = {ImportanceSource::Kind::Curve, points, {}};
   // The optimisation continues from its current state with the new importance (warm start).
 }
@@ -370,7 +393,9 @@ const Engine::ImportanceSource& Engine::importanceSource() const {
   return impl_->importanceSource;
 }
 
-bool Engine::hasImportance() const { return impl_->importance.has_value(); }
+bool Engine::hasImportance() const {
+  return impl_->importance.has_value();
+}
 const Field3D* Engine::importance() const {
   return impl_->importance ? &*impl_->importance : nullptr;
 }
@@ -378,7 +403,9 @@ const Field3D* Engine::importance() const {
 void Engine::setExtinctionSettings(const ExtinctionSettings& settings) {
   impl_->extinctionSettings = settings;
 }
-const ExtinctionSettings& Engine::extinctionSettings() const { return impl_->extinctionSettings; }
+const ExtinctionSettings& Engine::extinctionSettings() const {
+  return impl_->extinctionSettings;
+}
 
 void Engine::setViewportSize(int width, int height) {
   if (width <= 0 || height <= 0) throw Error(ErrorKind::Usage, "viewport size must be positive");
@@ -389,8 +416,8 @@ void Engine::setViewportSize(int width, int height) {
 std::vector<IterationStats> Engine::optimize(
     const std::function<bool(const IterationStats&)>& callback) {
   if (impl_->frozen) return {};
-  auto stats =
-      impl_->optimizer.runMultigrid(impl_->optimizationInputs(), impl_->extinctionSettings, callback);
+  auto stats = impl_->optimizer.runMultigrid(impl_->optimizationInputs(), impl_->extinctionSettings,
+                                             callback);
   impl_->lightDirty = true;
   return stats;
 }
@@ -404,16 +431,24 @@ std::vector<IterationStats> Engine::continueOptimization(
   return stats;
 }
 
-void Engine::setFrozen(bool frozen) { impl_->frozen = frozen; }
-bool Engine::frozen() const { return impl_->frozen; }
+void Engine::setFrozen(bool frozen) {
+  impl_->frozen = frozen;
+}
+bool Engine::frozen() const {
+  return impl_->frozen;
+}
 
 void Engine::resetOptimization() {
   impl_->optimizer.reset();
   impl_->lightDirty = true;
 }
 
-bool Engine::hasOptimizedExtinction() const { return impl_->optimizer.extinction() != nullptr; }
-const Field3D* Engine::optimizedExtinction() const { return impl_->optimizer.extinction(); }
+bool Engine::hasOptimizedExtinction() const {
+  return impl_->optimizer.extinction() != nullptr;
+}
+const Field3D* Engine::optimizedExtinction() const {
+  return impl_->optimizer.extinction();
+}
 
 void Engine::setRenderOptimized(bool useOptimized) {
   if (impl_->renderOptimized != useOptimized) impl_->lightDirty = true;

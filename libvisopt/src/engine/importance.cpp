@@ -108,8 +108,8 @@ std::vector<glm::dvec2> readImportanceCurve(const std::string& path) {
   return validated(points, path);
 }
 
-Field3D importanceFromVolumeFile(const Volume& volume, const std::string& path,
-                                 Precision precision, MemoryLedger* ledger) {
+Field3D importanceFromVolumeFile(const Volume& volume, const std::string& path, Precision precision,
+                                 MemoryLedger* ledger) {
   Volume g = readVolume(path, precision, nullptr);
   if (g.grid().dims != volume.grid().dims)
     throwBadInput(path, "the importance volume's dimensions differ from the data's");

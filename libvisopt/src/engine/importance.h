@@ -24,7 +24,7 @@ bool isCurveFile(const std::string& path);
 // {"points": [[value, g], ...]} or a visopt transfer-function JSON (its opacity read as g).
 std::vector<glm::dvec2> readImportanceCurve(const std::string& path);
 // A volume file on the volume's grid (same dims) with values in [0, 1].
-Field3D importanceFromVolumeFile(const Volume& volume, const std::string& path,
-                                 Precision precision, MemoryLedger* ledger);
+Field3D importanceFromVolumeFile(const Volume& volume, const std::string& path, Precision precision,
+                                 MemoryLedger* ledger);
 
 }  // namespace visopt

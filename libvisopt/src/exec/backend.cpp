@@ -95,7 +95,9 @@ Backend checkedBackend(Backend b) {
 
 ScopedBackend::ScopedBackend(Backend b)
     : previous_(backendOverride.exchange(static_cast<int>(checkedBackend(b)))) {}
-ScopedBackend::~ScopedBackend() { backendOverride.store(previous_); }
+ScopedBackend::~ScopedBackend() {
+  backendOverride.store(previous_);
+}
 
 void recordLaunch(const char* name, double ms, double items) {
   auto& r = registry();

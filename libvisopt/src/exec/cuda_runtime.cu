@@ -41,7 +41,9 @@ void* cudaAllocateManaged(size_t bytes) {
   return p;
 }
 
-void cudaFreeManaged(void* p) { cudaFree(p); }
+void cudaFreeManaged(void* p) {
+  cudaFree(p);
+}
 
 void cudaSynchronizeOrThrow(const char* name) {
   cudaError_t err = cudaGetLastError();

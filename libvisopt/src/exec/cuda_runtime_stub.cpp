@@ -9,8 +9,12 @@ bool cudaDeviceAnswers(std::string& why) {
   why = "built without CUDA";
   return false;
 }
-std::string cudaDeviceName() { return "none"; }
-void* cudaAllocateManaged(size_t) { throw Error(ErrorKind::Failure, "CUDA is not built in"); }
+std::string cudaDeviceName() {
+  return "none";
+}
+void* cudaAllocateManaged(size_t) {
+  throw Error(ErrorKind::Failure, "CUDA is not built in");
+}
 void cudaFreeManaged(void*) {}
 
 }  // namespace visopt::exec

@@ -18,9 +18,9 @@ struct OptimizerCoefficients {
   bool ademamix = true;
   float lr = 1e-3f;
   float beta1 = 0.9f, beta2 = 0.999f, beta3 = 0.9999f;  // beta3 = beta3(t) this step
-  float alpha = 0.f;                                     // alpha(t) this step
-  float biasCorrection1 = 1.f;  // 1 - beta1^t
-  float biasCorrection2 = 1.f;  // sqrt(1 - beta2^t)
+  float alpha = 0.f;                                    // alpha(t) this step
+  float biasCorrection1 = 1.f;                          // 1 - beta1^t
+  float biasCorrection2 = 1.f;                          // sqrt(1 - beta2^t)
   float epsilon = 1e-8f;
 };
 

@@ -28,7 +28,8 @@ struct ScreenWeights {
     const float v = 1.f - (float(j) + 0.5f) / float(ny);
     float w = 1.f;
     if (mask.valid())
-      w *= mask.sample(glm::vec3(u * float(mask.dims.x) - 0.5f, v * float(mask.dims.y) - 0.5f, 0.f));
+      w *=
+          mask.sample(glm::vec3(u * float(mask.dims.x) - 0.5f, v * float(mask.dims.y) - 0.5f, 0.f));
     if (lensRadius > 0.f) {
       const float r = glm::length(glm::vec2(u, v) - lensCentre) / lensRadius;
       const float inside = fminf(fmaxf((1.f - r) / 0.1f, 0.f), 1.f);  // 1 inside, 0 outside

@@ -16,15 +16,15 @@ namespace visopt {
 enum class RayMethod : int { Optimized = 0, MaxImportance = 1, CutAway = 2, Transparency = 3 };
 
 struct SurfaceRenderParams {
-  SurfaceSet surfaces;                       // visible surfaces, current phi
-  FieldView bases[kMaxContextSurfaces];      // phi0 of the same surfaces (deviation view)
+  SurfaceSet surfaces;                   // visible surfaces, current phi
+  FieldView bases[kMaxContextSurfaces];  // phi0 of the same surfaces (deviation view)
   glm::vec3 colors[kMaxContextSurfaces];
   bool deviationView = false;
-  float deviationScale = 0.1f;               // 1 / (voxel size * deviationMaxVoxels)
+  float deviationScale = 0.1f;  // 1 / (voxel size * deviationMaxVoxels)
   float ks = 0.3f, shininess = 32.f;
   bool ambientOcclusion = true;
-  float aoRadius = 6.f;                      // world units
-  float minStep = 0.25f;                     // surface tracing's smallest step, world units
+  float aoRadius = 6.f;   // world units
+  float minStep = 0.25f;  // surface tracing's smallest step, world units
   // Baselines: the method, ghat (Eq. 19) and g on the volume grid.
   RayMethod method = RayMethod::Optimized;
   FieldView importanceBehind, importance;
@@ -35,16 +35,17 @@ struct SurfaceRenderParams {
 // T_L plus ambient light darkened by ambient occlusion. lightT: T_L at the point, looked up just
 // outside the surface.
 VISOPT_HD inline glm::vec3 surfaceRadiance(const SurfaceRenderParams& s, const GridMap& grid,
-                                           int surface, glm::vec3 idx, glm::vec3 world,
-                                           glm::vec3 n, glm::vec3 toLight, glm::vec3 toEye,
-                                           float lightT, glm::vec3 lightRadiance, float ambient,
+                                           int surface, glm::vec3 idx, glm::vec3 world, glm::vec3 n,
+                                           glm::vec3 toLight, glm::vec3 toEye, float lightT,
+                                           glm::vec3 lightRadiance, float ambient,
                                            float volumeOcclusion) {
   glm::vec3 color = s.colors[surface];
   if (s.deviationView && s.bases[surface].valid())
     color = deviationColor(fabsf(s.bases[surface].sample(idx)) * s.deviationScale);
   const float brdf = surfaceBrdfCos(n, toLight, toEye, 1.f, s.ks, s.shininess);
   float ao = 1.f;
-  if (s.ambientOcclusion) ao = sdfOcclusion(s.surfaces, grid, world, n, s.aoRadius) * volumeOcclusion;
+  if (s.ambientOcclusion)
+    ao = sdfOcclusion(s.surfaces, grid, world, n, s.aoRadius) * volumeOcclusion;
   return color * (brdf * lightT * lightRadiance + glm::vec3(ambient * ao * 3.f));
 }
 

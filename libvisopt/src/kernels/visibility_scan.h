@@ -2,10 +2,11 @@
 // rays of a view- or light-space frustum grid.
 //
 // The discrete energy (the ground truth the gradient is checked against) is
-//   E = rho/2 sum_v (mu_v - mubar_v)^2 dV  -  q sum_c g_c mu_c T_c dV_c  -  r (same on the light grid)
+//   E = rho/2 sum_v (mu_v - mubar_v)^2 dV  -  q sum_c g_c mu_c T_c dV_c  -  r (same on the light
+//   grid)
 // over object voxels v and frustum cells c, with mu_c, g_c trilinear samples at the cell centres
-// (zero outside the volume's cells), exclusive transmittance T_c = exp(-sum_{j<k} mu_j ds) along the
-// cell's ray, and the cell volume dV_c = Omega_ij s_k^2 ds (Omega_ij: the pixel's solid angle).
+// (zero outside the volume's cells), exclusive transmittance T_c = exp(-sum_{j<k} mu_j ds) along
+// the cell's ray, and the cell volume dV_c = Omega_ij s_k^2 ds (Omega_ij: the pixel's solid angle).
 //
 // dE/dmu at a cell, per unit volume, is -q d_c with
 //   d_c = g_c T_c - G_c,   G_c = (1 / s_k^2) sum_{j>k} g_j mu_j T_j s_j^2 ds,
@@ -48,12 +49,12 @@ struct ScanSums {
 struct VisibilityScan {
   FrustumMap frustum;
   GridMap volume;
-  FieldView mu;          // extinction on the object grid
-  FieldView importance;  // g on the object grid
-  FieldView out;         // d on the frustum grid; T is kept there between the two passes
-  SurfaceSet surfaces;   // opaque context surfaces on the object grid (may be empty)
-  ScreenWeights weights; // view rays only
-  FieldView behindMax;   // optional: max of g behind each cell, on the frustum grid
+  FieldView mu;           // extinction on the object grid
+  FieldView importance;   // g on the object grid
+  FieldView out;          // d on the frustum grid; T is kept there between the two passes
+  SurfaceSet surfaces;    // opaque context surfaces on the object grid (may be empty)
+  ScreenWeights weights;  // view rays only
+  FieldView behindMax;    // optional: max of g behind each cell, on the frustum grid
 
   // Pixel solid angle (for cell volumes): the tan-plane area over (1 + u^2 + v^2)^(3/2).
   VISOPT_HD float solidAngle(int i, int j) const {
@@ -74,7 +75,8 @@ struct VisibilityScan {
     // beyond the outer voxel centres), so every voxel, boundary voxels included, is covered by
     // frustum cells in proportion to its volume, as the gather in extinction_step.h assumes.
     const glm::vec3 lo(-0.5f), hi = glm::vec3(volume.dims) - 0.5f;
-    if (idx.x < lo.x || idx.y < lo.y || idx.z < lo.z || idx.x > hi.x || idx.y > hi.y || idx.z > hi.z) {
+    if (idx.x < lo.x || idx.y < lo.y || idx.z < lo.z || idx.x > hi.x || idx.y > hi.y ||
+        idx.z > hi.z) {
       m = g = 0.f;
       opaque = false;
       return false;
@@ -113,7 +115,7 @@ struct VisibilityScan {
       occluderDepth += (1.f - gw) * m * ds;
     }
     // Back to front: G (behind, weighted by s^2) and d = g T - G.
-    float behind = 0.f;  // sum_{j>k} g mu T s^2 ds
+    float behind = 0.f;      // sum_{j>k} g mu T s^2 ds
     float runningMax = 0.f;  // max_{j>k} g
     for (int k = nz - 1; k >= 0; --k) {
       float m, g;

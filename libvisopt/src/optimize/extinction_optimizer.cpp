@@ -25,7 +25,9 @@ TransferLookup lookupOf(const DeviceBuffer<glm::vec4>* t) {
   return TransferLookup{t->data(), int(t->size())};
 }
 
-float voxelVolume(const GridSpec& g) { return g.spacing.x * g.spacing.y * g.spacing.z; }
+float voxelVolume(const GridSpec& g) {
+  return g.spacing.x * g.spacing.y * g.spacing.z;
+}
 
 // Runs the visibility scan of one frustum grid into `d` (allocated or resized as needed), and
 // the running maximum of g behind each cell into `behindMax` when that is requested.
@@ -118,8 +120,8 @@ ProblemEvaluation evaluateProblem(const ExtinctionProblem& p, Precision precisio
 
 std::vector<float> analyticGradient(const ExtinctionProblem& p, Precision precision) {
   ScanResult scans = scanProblem(p, precision);
-  ExtinctionGradient g = gradientOf(p, scans.dView ? &*scans.dView : nullptr,
-                                    scans.dLight ? &*scans.dLight : nullptr);
+  ExtinctionGradient g =
+      gradientOf(p, scans.dView ? &*scans.dView : nullptr, scans.dLight ? &*scans.dLight : nullptr);
   DeviceBuffer<float> out(p.grid.voxelCount());
   float* o = out.data();
   exec::parallelFor("gradient", int64_t(out.size()), [=] VISOPT_HD(int64_t v) {
@@ -144,7 +146,7 @@ struct ExtinctionOptimizer::Level {
   std::optional<Field3D> mask, ghat, viewMax, lightMax, scratch;
   FrustumGrid view, light;
   int shrink = 1;  // frustum grids are this many times coarser than at the finest level
-  int t = 0;  // optimiser steps taken on this level
+  int t = 0;       // optimiser steps taken on this level
   float gradientScale = 1.f;
   double motionSinceRedistance = 0.0;  // bound on |delta phi| since the last redistancing
   double lastEnergy = 0.0;
@@ -158,7 +160,9 @@ const Field3D* ExtinctionOptimizer::extinction() const {
   return level_ && level_->finest && level_->mu ? &*level_->mu : nullptr;
 }
 
-void ExtinctionOptimizer::reset() { level_.reset(); }
+void ExtinctionOptimizer::reset() {
+  level_.reset();
+}
 
 std::vector<const Field3D*> ExtinctionOptimizer::surfaces() const {
   std::vector<const Field3D*> out;
@@ -258,7 +262,8 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
       float b = 0.f, g = 0.f;
       for (int c = 0; c < 27; ++c) {
         glm::vec3 o(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
-        glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)) + o * offset / map.spacing);
+        glm::vec3 x =
+            map.toWorld(glm::vec3(float(i), float(j), float(k)) + o * offset / map.spacing);
         glm::vec3 fi = fineMap.toIndex(x);
         b += tf.at(scalars.sample(fi)).w;
         g += fineImp.sample(fi);
@@ -317,8 +322,7 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
 }
 
 IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
-                                                 const ExtinctionSettings& s, int levels,
-                                                 int cap) {
+                                                 const ExtinctionSettings& s, int levels, int cap) {
   Level& L = *level_;
   const int shrink = L.shrink;
   (void)levels;
@@ -439,8 +443,9 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
     L.gradientScale = rms > 1e-30 && std::isfinite(rms) ? float(1.0 / rms) : 1.f;
   }
   step.gradientScale = L.gradientScale;
-  StepSums sums = exec::reduce("extinction step", int64_t(L.grid.voxelCount()), StepSums{}, step,
-                               [] VISOPT_HD(const StepSums& a, const StepSums& b) { return a + b; });
+  StepSums sums =
+      exec::reduce("extinction step", int64_t(L.grid.voxelCount()), StepSums{}, step,
+                   [] VISOPT_HD(const StepSums& a, const StepSums& b) { return a + b; });
   st.extinctionStepMs = msSince(t1);
 
   st.iteration = t;
@@ -464,24 +469,23 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   const FrustumMap view(L.view), light(L.light);
   const FieldView viewMax = L.viewMax ? FieldView(*L.viewMax) : FieldView();
   const FieldView lightMax = L.lightMax ? FieldView(*L.lightMax) : FieldView();
-  exec::parallelFor("grid updates: importance behind", int64_t(L.grid.voxelCount()),
-                    [=] VISOPT_HD(int64_t v) {
-                      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-                                k = int(v / (int64_t(map.dims.x) * map.dims.y));
-                      const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
-                      const float vm = gatherFrustum(view, viewMax, x);
-                      const float g = lightMax.valid()
-                                          ? 0.5f * vm + 0.5f * gatherFrustum(light, lightMax, x)
-                                          : vm;
-                      ghat.store(size_t(v), fminf(fmaxf(g, 0.f), 1.f));
-                    });
+  exec::parallelFor(
+      "grid updates: importance behind", int64_t(L.grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
+        const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+                  k = int(v / (int64_t(map.dims.x) * map.dims.y));
+        const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
+        const float vm = gatherFrustum(view, viewMax, x);
+        const float g =
+            lightMax.valid() ? 0.5f * vm + 0.5f * gatherFrustum(light, lightMax, x) : vm;
+        ghat.store(size_t(v), fminf(fmaxf(g, 0.f), 1.f));
+      });
   const Field3D* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   LevelSetStepStats ls;
   for (size_t si = 0; si < L.phi.size(); ++si) {
     const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
     ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, in.levelSet, *L.scratch);
-    L.motionSinceRedistance = std::max(L.motionSinceRedistance,
-                                       ls.maxChange * double(std::max(ls.substeps, 1)));
+    L.motionSinceRedistance =
+        std::max(L.motionSinceRedistance, ls.maxChange * double(std::max(ls.substeps, 1)));
   }
   st.sdfStepMs = msSince(t0);
   st.levelSetTimeStep = ls.timeStep;
@@ -530,7 +534,8 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
 namespace {
 void validate(const OptimizationInputs& in, const ExtinctionSettings& s) {
   if (!in.volume || !in.importance || !in.transfer)
-    throw Error(ErrorKind::Usage, "optimisation needs a volume, an importance and a transfer function");
+    throw Error(ErrorKind::Usage,
+                "optimisation needs a volume, an importance and a transfer function");
   auto finite = [](float v) { return std::isfinite(v); };
   if (!finite(s.q) || !finite(s.r) || !finite(s.rho) || s.q < 0.f || s.r < 0.f)
     throw Error(ErrorKind::Usage, "q and r must be finite and non-negative, rho finite");

@@ -85,7 +85,7 @@ class ExtinctionOptimizer {
   const Field3D* importanceBehind() const;
   void reset();
 
- // Internal steps; public only because nvcc forbids extended device lambdas in private members.
+  // Internal steps; public only because nvcc forbids extended device lambdas in private members.
   struct Level;
   void buildLevel(const OptimizationInputs& in, const ExtinctionSettings& settings, int level,
                   int levels);

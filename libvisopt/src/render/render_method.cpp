@@ -4,10 +4,14 @@ namespace visopt {
 
 const char* toString(RenderMethod method) {
   switch (method) {
-    case RenderMethod::Optimized: return "ours";
-    case RenderMethod::MaxImportanceProjection: return "max-importance-projection";
-    case RenderMethod::CutAway: return "cut-away";
-    case RenderMethod::TransparencyModulation: return "transparency-modulation";
+    case RenderMethod::Optimized:
+      return "ours";
+    case RenderMethod::MaxImportanceProjection:
+      return "max-importance-projection";
+    case RenderMethod::CutAway:
+      return "cut-away";
+    case RenderMethod::TransparencyModulation:
+      return "transparency-modulation";
   }
   return "unknown";
 }

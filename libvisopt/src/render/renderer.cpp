@@ -7,8 +7,8 @@
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "kernels/ray_march.h"
-#include "kernels/surface_render.h"
 #include "kernels/ray_skip.h"
+#include "kernels/surface_render.h"
 #include "kernels/transmittance_scan.h"
 #include "kernels/volume_extinction.h"
 #include "visopt/error.h"
@@ -101,8 +101,12 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
                                Field3D& out) {
   if (out.grid().dims != lightFrustum.dims)
     throw Error(ErrorKind::Failure, "light transmittance field does not match its frustum");
-  TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum), GridMap(scene.volume->grid()),
-                                           FieldView(out), extinctionOf(scene), true, {}};
+  TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum),
+                                           GridMap(scene.volume->grid()),
+                                           FieldView(out),
+                                           extinctionOf(scene),
+                                           true,
+                                           {}};
   for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i)
     scan.surfaces.phi[scan.surfaces.count++] = FieldView(*scene.surfaces[i]);
   exec::parallelFor("light transmittance", int64_t(lightFrustum.dims.x) * lightFrustum.dims.y,
@@ -159,8 +163,7 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   p.surf.aoRadius = settings.ambientOcclusionRadius * grid.minSpacing();
   p.surf.minStep = 0.25f * grid.minSpacing();
   p.surf.method = static_cast<RayMethod>(static_cast<int>(settings.method));
-  if (settings.method != RenderMethod::Optimized &&
-      (!scene.importanceBehind || !scene.importance))
+  if (settings.method != RenderMethod::Optimized && (!scene.importanceBehind || !scene.importance))
     throw Error(ErrorKind::Usage, std::string("the ") + toString(settings.method) +
                                       " baseline needs an importance and a view (run an "
                                       "optimisation step first)");

@@ -118,8 +118,8 @@ BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* 
               {1.0, {0.35f, 0.50f, 0.25f}}};
   tf.validate("scene earth-mantle");
   // With context surfaces: the crust becomes a surface, transparent in the volume.
-  scene.contextSurfaces = {ContextSurfaceSpec{"iso:0.85:inside-high", true, 0.f,
-                                              glm::vec3(0.40f, 0.55f, 0.32f), true}};
+  scene.contextSurfaces = {
+      ContextSurfaceSpec{"iso:0.85:inside-high", true, 0.f, glm::vec3(0.40f, 0.55f, 0.32f), true}};
   scene.contextTransferFunction = tf;
   scene.contextTransferFunction.opacity = {{-1.0, 0.6f}, {-0.5, 0.45f}, {-0.3, 0.f}, {0.3, 0.f},
                                            {0.55, 0.5f}, {0.8, 0.7f},   {0.85, 0.f}, {1.0, 0.f}};

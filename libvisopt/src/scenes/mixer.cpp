@@ -121,11 +121,11 @@ BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger
               {1.0, {0.80f, 0.10f, 0.10f}}};
   tf.validate("scene mixer");
   // With context surfaces: the tank wall, rod and paddle become a surface.
-  scene.contextSurfaces = {ContextSurfaceSpec{"iso:-0.5:inside-low", true, 0.f,
-                                              glm::vec3(0.62f, 0.66f, 0.72f), true}};
+  scene.contextSurfaces = {
+      ContextSurfaceSpec{"iso:-0.5:inside-low", true, 0.f, glm::vec3(0.62f, 0.66f, 0.72f), true}};
   scene.contextTransferFunction = tf;
-  scene.contextTransferFunction.opacity = {{-1.0, 0.f}, {0.15, 0.f}, {0.3, 0.08f}, {0.6, 0.4f},
-                                           {1.0, 0.6f}};
+  scene.contextTransferFunction.opacity = {
+      {-1.0, 0.f}, {0.15, 0.f}, {0.3, 0.08f}, {0.6, 0.4f}, {1.0, 0.6f}};
   scene.azimuthDeg = 30.f;
   scene.elevationDeg = 20.f;
   scene.distanceInRadii = 2.8f;

@@ -98,11 +98,12 @@ BuiltinScene makeSheppLogan(int resolution, Precision precision, MemoryLedger* l
   tf.validate("scene shepp-logan");
   // With context surfaces: the skull shell becomes a surface (the wall between the isovalue 0.5
   // on both faces, filled), and the volume shows only what is inside it.
-  scene.contextSurfaces = {ContextSurfaceSpec{"iso:0.5:inside-high", true, 0.f,
-                                              glm::vec3(0.93f, 0.74f, 0.62f), true}};
+  scene.contextSurfaces = {
+      ContextSurfaceSpec{"iso:0.5:inside-high", true, 0.f, glm::vec3(0.93f, 0.74f, 0.62f), true}};
   scene.contextTransferFunction = tf;
-  scene.contextTransferFunction.opacity = {{0.0, 0.f},    {0.1, 0.f},  {0.2, 0.005f}, {0.25, 0.005f},
-                                           {0.28, 0.35f}, {0.32, 0.35f}, {0.36, 0.f}, {1.0, 0.f}};
+  scene.contextTransferFunction.opacity = {{0.0, 0.f},     {0.1, 0.f},    {0.2, 0.005f},
+                                           {0.25, 0.005f}, {0.28, 0.35f}, {0.32, 0.35f},
+                                           {0.36, 0.f},    {1.0, 0.f}};
   scene.azimuthDeg = 25.f;
   scene.elevationDeg = 20.f;
   scene.distanceInRadii = 2.8f;

@@ -119,3 +119,38 @@ TEST(ContextSurfaces, WorldMaskKeepsTheCap) {
   EXPECT_LT(std::abs(capChange(e)), 0.3f) << "deviation ~0 under the mask";
   EXPECT_LT(stats.back().visibilityView, 0.05) << "the cap stays, so the blob stays hidden";
 }
+
+// A lens of strength 0 over the disc (paper 000 §III-F) removes the importance along exactly
+// those rays: the shell keeps its cap and the disc stays hidden; the same lens elsewhere on the
+// screen changes nothing. A screen-space windowing mask of zeros over the disc does the same.
+TEST(ContextSurfaces, LensAndScreenMaskModulateTheImportanceAlongTheirRays) {
+  auto run = [](auto configure) {
+    Engine e;
+    setup(e);
+    configure(e);
+    const auto stats = e.optimize();
+    return std::make_pair(stats.back().visibilityView, capChange(e));
+  };
+  ImportanceLens over;  // the disc is at the image centre, about a third of the width across
+  over.x = 0.5f;
+  over.y = 0.5f;
+  over.radius = 0.3f;
+  over.strength = 0.f;
+  const auto blocked = run([&](Engine& e) { e.setLens(over); });
+  EXPECT_LT(blocked.first, 0.05) << "no importance under the lens: nothing opens";
+  EXPECT_LT(std::abs(blocked.second), 0.3f);
+
+  ImportanceLens aside = over;
+  aside.x = 0.08f;
+  aside.radius = 0.05f;
+  const auto open = run([&](Engine& e) { e.setLens(aside); });
+  EXPECT_GT(open.first, 0.5) << "a lens elsewhere leaves the disc's rays alone";
+
+  const auto masked = run([](Engine& e) {
+    std::vector<float> w(32 * 32, 1.f);
+    for (int y = 8; y < 24; ++y)
+      for (int x = 8; x < 24; ++x) w[size_t(y) * 32 + size_t(x)] = 0.f;
+    e.setScreenMask(w, 32, 32);
+  });
+  EXPECT_LT(masked.first, 0.05) << "a zero window over the disc keeps it hidden";
+}

@@ -92,6 +92,10 @@ class Engine {
   const Field3D* worldMask() const;
   void setLens(const ImportanceLens& lens);
   const ImportanceLens& lens() const;
+  // Screen-space windowing mask (Fig. 8): weights in [0, 1] over a width x height raster that
+  // covers the image (row 0 at the top), multiplying the importance along the view rays.
+  void setScreenMask(const std::vector<float>& weights, int width, int height);
+  void clearScreenMask();
   // ghat (Eq. 19) of the last optimisation iteration, when there are surfaces.
   const Field3D* importanceBehind() const;
 

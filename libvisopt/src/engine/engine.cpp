@@ -42,6 +42,7 @@ struct Engine::Impl {
   LevelSetSettings levelSet;
   std::optional<Field3D> worldMask;
   ImportanceLens lens;
+  std::optional<Field3D> screenMask;
   ExtinctionSettings extinctionSettings;
   ExtinctionOptimizer optimizer{&ledger, Precision::FP32};
   bool frozen = false;
@@ -79,6 +80,7 @@ struct Engine::Impl {
     in.levelSet = levelSet;
     in.worldMask = worldMask ? &*worldMask : nullptr;
     in.lens = lens;
+    in.screenMask = screenMask ? &*screenMask : nullptr;
     return in;
   }
 
@@ -363,6 +365,23 @@ void Engine::setLens(const ImportanceLens& lens) {
 const ImportanceLens& Engine::lens() const {
   return impl_->lens;
 }
+
+void Engine::setScreenMask(const std::vector<float>& weights, int width, int height) {
+  if (width <= 0 || height <= 0 || weights.size() != size_t(width) * size_t(height))
+    throw Error(ErrorKind::Usage, "a screen mask needs width x height weights");
+  GridSpec g;
+  g.dims = glm::ivec3(width, height, 1);
+  impl_->screenMask.reset();
+  impl_->screenMask.emplace("screen-mask", g, Precision::FP32, &impl_->ledger);
+  for (size_t i = 0; i < weights.size(); ++i) {
+    const float w = weights[i];
+    if (!std::isfinite(w) || w < 0.f || w > 1.f)
+      throw Error(ErrorKind::Usage, "screen-mask weights must lie in [0, 1]");
+    impl_->screenMask->set(i, w);  // row 0 at the top, as ScreenWeights reads it
+  }
+}
+
+void Engine::clearScreenMask() { impl_->screenMask.reset(); }
 
 const Field3D* Engine::importanceBehind() const {
   return impl_->optimizer.importanceBehind();

@@ -369,6 +369,7 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
     weights.lensRadius = in.lens.radius;
     weights.lensStrength = in.lens.strength;
   }
+  if (in.screenMask) weights.mask = FieldView(*in.screenMask);
   auto t0 = Clock::now();
   ScanSums view, light;
   if (p.q != 0.f || hasSurfaces)

@@ -33,6 +33,7 @@ struct OptimizationInputs {
   LevelSetSettings levelSet;
   const Field3D* worldMask = nullptr;  // > 0.5: surfaces keep their base shape there
   ImportanceLens lens;
+  const Field3D* screenMask = nullptr;  // width x height x 1 weights, row 0 at the top
 };
 
 // Returning false from the callback stops the run after that iteration.

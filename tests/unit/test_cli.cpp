@@ -1,6 +1,7 @@
 // The visopt command-line tool as a script would use it: exit codes (0 ok, 1 usage, 2 bad input,
 // 3 other), one JSON object on stdout with --json, one-line errors naming the file.
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -131,4 +132,38 @@ TEST(Cli, OptimizeReportsFallingEnergyAndRisingVisibility) {
             j["initial"]["visibility_view"].get<double>());
   EXPECT_TRUE(fs::exists(out));
   EXPECT_TRUE(fs::exists(tmp("opt-before.png")));
+}
+
+TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
+  // A small raw volume: a ball of value 100 in 0; the ball is the context surface (iso 50).
+  const std::string raw = tmp("ball.raw");
+  {
+    std::ofstream f(raw, std::ios::binary);
+    for (int k = 0; k < 24; ++k)
+      for (int j = 0; j < 24; ++j)
+        for (int i = 0; i < 24; ++i) {
+          const float r = std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
+          const float v = r < 4.f ? 150.f : (r < 8.f ? 100.f : 0.f);
+          f.write(reinterpret_cast<const char*>(&v), 4);
+        }
+    std::ofstream(raw + ".json") << R"({"dims":[24,24,24],"type":"float32","spacing":[1,1,1]})";
+  }
+  std::ofstream(tmp("g.json")) << R"({"points":[[0,0],[120,0],[140,1]]})";
+  const std::string out = tmp("ctx.png");
+  Result r = run("optimize --volume " + raw + " --importance " + tmp("g.json") +
+                 " --context iso:50:inside-high --shell 1 --lambda 0.5 --redist-iterations 16"
+                 " --lens 10,10,5,1.5 --deviation-view --view-from 90,0,3 --size 48x48"
+                 " --levels 1 --iterations 5 --out " + out + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["iterations"].size(), 5u);
+  EXPECT_TRUE(j["final"].contains("sdf_step_ms"));
+  EXPECT_TRUE(j["final"].contains("max_deviation_voxels"));
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(tmp("ctx-view.png")));
+  // Malformed context and lens specifications are usage errors; a missing mesh is bad input.
+  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --context iso:abc").code, 1);
+  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --lens 1,2").code, 1);
+  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --context mesh:" +
+                tmp("nope.obj")).code, 2);
 }

@@ -142,7 +142,8 @@ TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
     for (int k = 0; k < 24; ++k)
       for (int j = 0; j < 24; ++j)
         for (int i = 0; i < 24; ++i) {
-          const float r = std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
+          const float r =
+              std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
           const float v = r < 4.f ? 150.f : (r < 8.f ? 100.f : 0.f);
           f.write(reinterpret_cast<const char*>(&v), 4);
         }
@@ -153,7 +154,8 @@ TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
   Result r = run("optimize --volume " + raw + " --importance " + tmp("g.json") +
                  " --context iso:50:inside-high --shell 1 --lambda 0.5 --redist-iterations 16"
                  " --lens 10,10,5,1.5 --deviation-view --view-from 90,0,3 --size 48x48"
-                 " --levels 1 --iterations 5 --out " + out + " --json");
+                 " --levels 1 --iterations 5 --out " +
+                 out + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j["iterations"].size(), 5u);
@@ -162,8 +164,14 @@ TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
   EXPECT_TRUE(fs::exists(out));
   EXPECT_TRUE(fs::exists(tmp("ctx-view.png")));
   // Malformed context and lens specifications are usage errors; a missing mesh is bad input.
-  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --context iso:abc").code, 1);
-  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --lens 1,2").code, 1);
-  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --context mesh:" +
-                tmp("nope.obj")).code, 2);
+  EXPECT_EQ(
+      run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --context iso:abc")
+          .code,
+      1);
+  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") + " --lens 1,2").code,
+            1);
+  EXPECT_EQ(run("optimize --volume " + raw + " --importance " + tmp("g.json") +
+                " --context mesh:" + tmp("nope.obj"))
+                .code,
+            2);
 }

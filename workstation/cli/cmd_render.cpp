@@ -20,7 +20,7 @@ Runner addRenderCommand(CLI::App& app) {
     std::string volume, scene, session, tf, size = "512x512", camera, precision = "fp32", out;
     int resolution = 128;
     float step = 0.5f;
-    bool preview = false, json = false, noJitter = false;
+    bool deviationView = false, preview = false, json = false, noJitter = false;
   };
   auto o = std::make_shared<Options>();
   CLI::Option* volumeOption = app.add_option(
@@ -41,6 +41,8 @@ Runner addRenderCommand(CLI::App& app) {
                  "bounding-sphere radii");
   app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
   app.add_option("--step", o->step, "Ray-march step in units of the smallest voxel spacing");
+  app.add_flag("--deviation-view", o->deviationView,
+               "Colour context surfaces by |phi0| at the hit, in voxels (Fig. 5)");
   app.add_flag("--preview", o->preview, "Low-resolution preview (1/4 size, double step)");
   app.add_flag("--no-jitter", o->noJitter, "Sample at segment midpoints (shows wood grain)");
   app.add_option("--out", o->out, "Output PNG")->required();
@@ -92,6 +94,7 @@ Runner addRenderCommand(CLI::App& app) {
     }
     if (!session || given("--step")) settings.stepFactor = o->step;
     if (!session || o->preview) settings.preview = o->preview;
+    if (!session || o->deviationView) settings.deviationView = o->deviationView;
     if (!session || o->noJitter) settings.jitter = !o->noJitter;
     RenderStats stats;
     Image image = engine.render(settings, &stats);

@@ -381,7 +381,9 @@ void Engine::setScreenMask(const std::vector<float>& weights, int width, int hei
   }
 }
 
-void Engine::clearScreenMask() { impl_->screenMask.reset(); }
+void Engine::clearScreenMask() {
+  impl_->screenMask.reset();
+}
 
 const Field3D* Engine::importanceBehind() const {
   return impl_->optimizer.importanceBehind();

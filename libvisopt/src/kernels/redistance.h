@@ -70,7 +70,12 @@ struct RedistanceKernel {
     };
     const float bandGrad = sqrtf(slope(oneSided(xm, c, xp, ax)) + slope(oneSided(ym, c, yp, ay)) +
                                  slope(oneSided(zm, c, zp, az)));
-    const float bandValue = initialise && bandGrad > 0.f ? c / bandGrad : c;
+    // A band voxel whose neighbourhood is already distance-like (|grad phi| within 3 % of 1) keeps
+    // its value: re-estimating it at every redistancing moves the interface by the estimate's
+    // own O(h) error each time, which shows as speckles of deviation all over a surface and,
+    // next to a thin wall's medial kink a voxel away, does not even settle.
+    const bool distanceLike = fabsf(bandGrad - 1.f) < 0.03f;
+    const float bandValue = initialise && !distanceLike && bandGrad > 0.f ? c / bandGrad : c;
 
     // Sussman's update elsewhere.
     const float sgn = c / sqrtf(c * c + dxMin * dxMin);

@@ -32,9 +32,10 @@ VISOPT_HD inline float surfaceBrdfCos(glm::vec3 n, glm::vec3 toLight, glm::vec3 
 // SDF keeps, which Blinn-Phong highlights would otherwise show as rings.
 VISOPT_HD inline glm::vec3 surfaceNormal(const FieldView& phi, glm::vec3 p, const GridMap& grid) {
   const float o = 1.5f;
-  glm::vec3 g((phi.sample(p + glm::vec3(o, 0, 0)) - phi.sample(p - glm::vec3(o, 0, 0))) / grid.spacing.x,
-              (phi.sample(p + glm::vec3(0, o, 0)) - phi.sample(p - glm::vec3(0, o, 0))) / grid.spacing.y,
-              (phi.sample(p + glm::vec3(0, 0, o)) - phi.sample(p - glm::vec3(0, 0, o))) / grid.spacing.z);
+  glm::vec3 g(
+      (phi.sample(p + glm::vec3(o, 0, 0)) - phi.sample(p - glm::vec3(o, 0, 0))) / grid.spacing.x,
+      (phi.sample(p + glm::vec3(0, o, 0)) - phi.sample(p - glm::vec3(0, o, 0))) / grid.spacing.y,
+      (phi.sample(p + glm::vec3(0, 0, o)) - phi.sample(p - glm::vec3(0, 0, o))) / grid.spacing.z);
   g = grid.direction * g;
   const float len = glm::length(g);
   return len > 1e-12f ? g / len : glm::vec3(0.f, 0.f, 1.f);

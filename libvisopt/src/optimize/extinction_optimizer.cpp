@@ -204,6 +204,22 @@ void resample(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   });
 }
 
+// Prolongation of a surface's deviation: phi_fine = phi0_fine + (phi_coarse - phi0_coarse),
+// trilinear. Prolonging phi itself would replace the fine base shape by the coarse level's
+// blurred (min-restricted) one wherever nothing moved, leaving voxel-scale ripples for the slow
+// return term to remove.
+void prolongDeviation(const Field3D& phiCoarse, const Field3D& baseCoarse, const GridMap& coarse,
+                      const Field3D& baseFine, Field3D& phiFine) {
+  const FieldView pc(phiCoarse), bc(baseCoarse), bf(baseFine), out(phiFine);
+  const GridMap map(phiFine.grid());
+  exec::parallelFor("multigrid prolong sdf", int64_t(phiFine.size()), [=] VISOPT_HD(int64_t v) {
+    const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+              k = int(v / (int64_t(map.dims.x) * map.dims.y));
+    const glm::vec3 q = coarse.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))));
+    out.store(size_t(v), bf.load(size_t(v)) + (pc.sample(q) - bc.sample(q)));
+  });
+}
+
 // Restriction of an SDF to a coarser grid: the minimum over 3^3 points spread over each coarse
 // voxel, so a surface thinner than a coarse voxel (a skull, a thin shell) does not vanish from
 // the coarse levels, where it would otherwise let the view through.
@@ -300,9 +316,17 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     if (!next->finest) {
       next->phi0.emplace_back("surface-base (coarse)", grid, precision_, ledger_);
       restrictSdf(base, fineMap, next->phi0.back());
+      // The min-restriction is not a distance field; redistance it once here so that the
+      // level's own redistancing does not move its surface (which the next level would inherit
+      // as a deviation).
+      Field3D scratch("surface-scratch", grid, precision_, nullptr);
+      redistance(next->phi0.back(), in.levelSet, scratch);
     }
     next->phi.emplace_back("surface", grid, precision_, ledger_);
-    if (level_ && si < level_->phi.size())
+    if (level_ && si < level_->phi.size() && si < level_->phi0.size())
+      prolongDeviation(level_->phi[si], level_->phi0[si], GridMap(level_->grid),
+                       next->finest ? base : next->phi0.back(), next->phi.back());
+    else if (level_ && si < level_->phi.size())
       resample(level_->phi[si], GridMap(level_->grid), next->phi.back());
     else
       resample(next->finest ? base : next->phi0.back(), next->finest ? fineMap : map,

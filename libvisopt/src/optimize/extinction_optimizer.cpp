@@ -541,7 +541,9 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
         [=] VISOPT_HD(int64_t v) {
           DeviationSums r;
           if (fabsf(phi.load(size_t(v))) <= 0.5f * h) {
-            const double dev = fabsf(base.load(size_t(v))) / h;
+            // phi0 - phi at a voxel next to the current surface is phi0 at (about) the
+            // nearest surface point: how far the surface has moved from its base there.
+            const double dev = fabsf(base.load(size_t(v)) - phi.load(size_t(v))) / h;
             r.sum = dev;
             r.max = dev;
             r.count = 1;

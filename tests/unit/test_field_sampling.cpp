@@ -87,3 +87,16 @@ TEST(Exec, ParallelForReduceAndNamedTimings) {
   EXPECT_EQ(t[0].items, 10000.0);
   EXPECT_EQ(t[1].name, "test-sum");
 }
+
+TEST(Field, RenameMovesTheLedgerEntry) {
+  MemoryLedger a, b;
+  GridSpec g;
+  g.dims = {4, 4, 4};
+  Field3D f("old", g, Precision::FP16, &a);
+  f.rename("new", &b);
+  EXPECT_EQ(a.totalBytes(), 0u);
+  ASSERT_EQ(b.entries().size(), 1u);
+  EXPECT_EQ(b.entries()[0].name, "new");
+  EXPECT_EQ(b.entries()[0].bytes, 128u);
+  EXPECT_EQ(f.name(), "new");
+}

@@ -19,20 +19,6 @@ nlohmann::json referenceJson(const SessionDataReport& d) {
           {"bytes", d.reference.bytes}};
 }
 
-const char* importanceName(SessionImportance::Kind kind) {
-  switch (kind) {
-    case SessionImportance::Kind::Scene:
-      return "scene";
-    case SessionImportance::Kind::Curve:
-      return "curve";
-    case SessionImportance::Kind::Volume:
-      return "volume";
-    case SessionImportance::Kind::None:
-      break;
-  }
-  return "none";
-}
-
 }  // namespace
 
 Runner addSessionInfoCommand(CLI::App& app) {
@@ -65,7 +51,7 @@ Runner addSessionInfoCommand(CLI::App& app) {
           {"source", source},
           {"precision", toString(s.precision)},
           {"transfer_function", s.transferFunction ? s.transferFunction->name : ""},
-          {"importance", importanceName(s.importance.kind)},
+          {"importance", toString(s.importance.kind)},
           {"context_surfaces", s.contextSurfaces.size()},
           {"frozen", s.frozen},
           {"world_mask", s.worldMask ? nlohmann::json{{"dims",
@@ -84,7 +70,7 @@ Runner addSessionInfoCommand(CLI::App& app) {
     std::printf("precision:   %s\n", toString(s.precision));
     std::printf("transfer fn: %s\n",
                 s.transferFunction ? s.transferFunction->name.c_str() : "(the data's default)");
-    std::printf("importance:  %s\n", importanceName(s.importance.kind));
+    std::printf("importance:  %s\n", toString(s.importance.kind));
     for (size_t i = 0; i < s.contextSurfaces.size(); ++i)
       std::printf("surface %zu:   %s%s\n", i + 1, s.contextSurfaces[i].spec.source.c_str(),
                   s.contextSurfaces[i].spec.visible ? "" : " (hidden)");

@@ -27,6 +27,8 @@ class Field3D {
   Field3D& operator=(const Field3D&) = delete;
 
   bool empty() const { return data_ == nullptr; }
+  // Renames the field and moves its ledger entry to `ledger` (may be null) under the new name.
+  void rename(std::string name, MemoryLedger* ledger);
   const std::string& name() const { return name_; }
   const GridSpec& grid() const { return grid_; }
   Precision precision() const { return precision_; }

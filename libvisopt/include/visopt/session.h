@@ -94,6 +94,9 @@ struct SessionImportance {
   DataReference volume;           // Volume: the importance file
 };
 
+// "none", "scene", "curve" or "volume": the names the session format uses.
+const char* toString(SessionImportance::Kind kind);
+
 struct SessionSurface {
   ContextSurfaceSpec spec;  // as the user gave it ("mesh:/old/place.obj")
   DataReference file;       // mesh:/vdb: sources: the file; empty for iso:

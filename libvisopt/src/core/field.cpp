@@ -54,6 +54,13 @@ Field3D& Field3D::operator=(Field3D&& o) noexcept {
   return *this;
 }
 
+void Field3D::rename(std::string name, MemoryLedger* ledger) {
+  if (ledger_ && ledgerToken_) ledger_->remove(ledgerToken_);
+  name_ = std::move(name);
+  ledger_ = ledger;
+  ledgerToken_ = ledger_ && data_ ? ledger_->add(name_, bytes(), toString(precision_)) : 0;
+}
+
 float Field3D::get(size_t i) const {
   return FieldView(*this).load(i);
 }

@@ -63,11 +63,10 @@ Field3D buildContextSurface(const ContextSurfaceSpec& spec, const Volume& volume
     o.filled = spec.filled;
     o.shellThickness = spec.shell;
     o.like = volume.grid();
+    // sdfFromMesh already makes the shell when asked.
     Field3D sdf = sdfFromMesh(spec.source.substr(5), o, precision, nullptr, nullptr, progress);
-    // sdfFromMesh already made the shell when asked.
-    Field3D out("surface-base", volume.grid(), precision, ledger);
-    for (size_t i = 0; i < out.size(); ++i) out.set(i, sdf.get(i));
-    return out;
+    sdf.rename("surface-base", ledger);
+    return sdf;
   } else if (startsWith(spec.source, "vdb:")) {
     phi0 = readSdfVdb(spec.source.substr(4), volume.grid(), precision, nullptr);
   } else {
@@ -75,10 +74,9 @@ Field3D buildContextSurface(const ContextSurfaceSpec& spec, const Volume& volume
                                       "': expected iso:VALUE[:inside-high|inside-low], mesh:FILE "
                                       "or vdb:FILE");
   }
-  if (!spec.filled) return thinShell(phi0, spec.shell, precision, ledger);
-  Field3D out("surface-base", volume.grid(), precision, ledger);
-  for (size_t i = 0; i < out.size(); ++i) out.set(i, phi0.get(i));
-  return out;
+  if (!spec.filled) phi0 = thinShell(phi0, spec.shell, precision, nullptr);
+  phi0.rename("surface-base", ledger);
+  return phi0;
 }
 
 }  // namespace visopt

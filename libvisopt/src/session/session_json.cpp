@@ -52,20 +52,6 @@ DataReference referenceFromJson(const json& j, const Where& where) {
   return ref;
 }
 
-const char* importanceKindName(SessionImportance::Kind kind) {
-  switch (kind) {
-    case SessionImportance::Kind::Scene:
-      return "scene";
-    case SessionImportance::Kind::Curve:
-      return "curve";
-    case SessionImportance::Kind::Volume:
-      return "volume";
-    case SessionImportance::Kind::None:
-      break;
-  }
-  return "none";
-}
-
 void putIfNotEmpty(OrderedJson& doc, const char* key, OrderedJson value) {
   if (!value.empty()) doc[key] = std::move(value);
 }
@@ -225,7 +211,7 @@ std::string sessionToJson(const Session& s, const std::string& sessionPath) {
   if (s.transferFunction)
     doc["transferFunction"] = OrderedJson::parse(s.transferFunction->toJson());
   if (s.importance.kind != SessionImportance::Kind::None) {
-    OrderedJson imp = {{"kind", importanceKindName(s.importance.kind)}};
+    OrderedJson imp = {{"kind", toString(s.importance.kind)}};
     if (s.importance.kind == SessionImportance::Kind::Curve) {
       OrderedJson points = OrderedJson::array();
       for (const auto& p : s.importance.curve) points.push_back({p.x, p.y});
@@ -293,6 +279,20 @@ Session sessionFromJson(const std::string& text, const std::string& origin) {
   } catch (const json::exception& e) {  // a structure no check above foresaw
     top.fail("malformed session: " + oneLine(e.what()));
   }
+}
+
+const char* toString(SessionImportance::Kind kind) {
+  switch (kind) {
+    case SessionImportance::Kind::Scene:
+      return "scene";
+    case SessionImportance::Kind::Curve:
+      return "curve";
+    case SessionImportance::Kind::Volume:
+      return "volume";
+    case SessionImportance::Kind::None:
+      break;
+  }
+  return "none";
 }
 
 }  // namespace visopt

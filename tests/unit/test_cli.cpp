@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "visopt/image.h"
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -95,6 +97,30 @@ TEST(Cli, UsageErrorsExitOne) {
   EXPECT_EQ(run("render --scene builtin:shepp-logan --precision fp8 --out " + tmp("x.png")).code,
             1);
   EXPECT_EQ(run("optimize --scene builtin:shepp-logan --optimizer sgd").code, 1);
+}
+
+TEST(Cli, DeviationColormapIsChosenByName) {
+  const std::string a = tmp("dev-viridis.png"), b = tmp("dev-magma.png");
+  const std::string common =
+      "render --scene builtin:shepp-logan --resolution 48 --size 64x64 "
+      "--deviation-view --out ";
+  ASSERT_EQ(run(common + a).code, 0);
+  ASSERT_EQ(run(common + b + " --deviation-colormap magma").code, 0);
+  // The surfaces are on their base shape: colormap(0), viridis' dark purple against magma's
+  // near black, so the two images differ.
+  const visopt::Image ia = visopt::readPng(a), ib = visopt::readPng(b);
+  ASSERT_EQ(ia.pixels.size(), ib.pixels.size());
+  float diff = 0.f;
+  for (size_t i = 0; i < ia.pixels.size(); ++i) {
+    const glm::vec3 d = glm::abs(ia.pixels[i] - ib.pixels[i]);
+    diff += d.x + d.y + d.z;
+  }
+  EXPECT_GT(diff, 0.5f) << "--deviation-colormap had no effect";
+  const Result bad = run(common + tmp("dev-bad.png") + " --deviation-colormap jet");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(lastLine(bad.err).find("viridis, magma, inferno, coolwarm, grey"), std::string::npos)
+      << bad.err;
+  EXPECT_EQ(run("optimize --scene builtin:shepp-logan --deviation-colormap jet").code, 1);
 }
 
 TEST(Cli, BadInputExitsTwoWithOneLineNamingTheFile) {

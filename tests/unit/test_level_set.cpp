@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/device_bit_mask.h"
 #include "core/field_view.h"
 #include "optimize/level_set.h"
 #include "visopt/error.h"
@@ -312,8 +313,9 @@ TEST_P(LevelSet, MaskedRegionReturnsToBase) {
   Field3D phi0 = makeField("phi0", g, GetParam(), base);
   Field3D phi = makeField("phi", g, GetParam(), [&](glm::vec3 x) { return base(x) - 1.f; });
   Field3D ghat = makeField("ghat", g, GetParam(), constant(0.5f));
-  Field3D mask = makeField("mask", g, Precision::FP32,
-                           [&](glm::vec3 x) { return x.x < centre.x ? 1.f : 0.f; });
+  const Field3D maskField = makeField("mask", g, Precision::FP32,
+                                      [&](glm::vec3 x) { return x.x < centre.x ? 1.f : 0.f; });
+  const DeviceBitMask mask(packMask(maskField), "mask", nullptr);
   Field3D scratch;
   LevelSetSettings s;
   s.lambda = 1.f;  // lambda(x) = 0.5 where ghat = 0.5
@@ -479,7 +481,8 @@ TEST(LevelSetErrors, MismatchedGridsAndBadSettings) {
   LevelSetSettings s;
   EXPECT_THROW(levelSetStep(phi, other, phi, nullptr, s, scratch), Error);
   EXPECT_THROW(levelSetStep(phi, phi, other, nullptr, s, scratch), Error);
-  EXPECT_THROW(levelSetStep(phi, phi, phi, &other, s, scratch), Error);
+  const DeviceBitMask otherMask(glm::ivec3(9), "mask", nullptr);
+  EXPECT_THROW(levelSetStep(phi, phi, phi, &otherMask, s, scratch), Error);
   s.cfl = 0.f;
   EXPECT_THROW(levelSetStep(phi, phi, phi, nullptr, s, scratch), Error);
 }

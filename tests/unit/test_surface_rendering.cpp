@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include "kernels/surface_shading.h"
 #include "render_fixtures.h"
 #include "visopt/engine.h"
 
@@ -131,10 +130,21 @@ TEST(SurfaceRendering, DeviationViewColoursByTheBaseDistance) {
   rs.deviationView = true;
   const Image img = e.render(rs);
   // Unoptimised: the surface is phi0's zero set, so the deviation is 0: colormap(0), lit as the
-  // Lambertian centre is.
-  const glm::vec3 expected = deviationColor(0.f) * 3.f / kPi;
+  // Lambertian centre is. Viridis starts at sRGB (0.267004, 0.004874, 0.329415) (matplotlib),
+  // magma at (0.001462, 0.000466, 0.013866); decoded to linear light here independently.
+  auto linear = [](float c) {
+    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  };
+  const glm::vec3 viridis0(linear(0.267004f), linear(0.004874f), linear(0.329415f));
+  glm::vec3 expected = viridis0 * 3.f / kPi;
   for (int c = 0; c < 3; ++c)
     EXPECT_NEAR(img.at(16, 16)[c], expected[c], 0.03f * expected[c] + 1e-3f);
+  rs.deviationColormap = Colormap::Magma;
+  const Image magma = e.render(rs);
+  expected = glm::vec3(linear(0.001462f), linear(0.000466f), linear(0.013866f)) * 3.f / kPi;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(magma.at(16, 16)[c], expected[c], 0.03f * expected[c] + 1e-3f);
+  EXPECT_LT(magma.at(16, 16).z, 0.2f * img.at(16, 16).z) << "the colormap setting is ignored";
 }
 
 TEST(SurfaceRendering, TheFourMethodsDiffer) {

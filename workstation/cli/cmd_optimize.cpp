@@ -57,7 +57,8 @@ std::string beforePath(const std::string& out) {
 Runner addOptimizeCommand(CLI::App& app) {
   struct Options {
     std::string volume, scene, tf, importance, camera, light, viewFrom,
-        size = "512x512", precision = "fp32", optimizer = "ademamix", out, worldMask, lens;
+        size = "512x512", precision = "fp32", optimizer = "ademamix", out, worldMask, lens,
+        deviationColormap = "viridis";
     std::vector<std::string> contexts;
     float shell = -1.f, lambda = -1.f;
     int redistIterations = -1;
@@ -106,6 +107,8 @@ Runner addOptimizeCommand(CLI::App& app) {
                  "Importance lens X,Y,R[,STRENGTH] in output-image pixels (strength multiplies g)");
   app.add_flag("--deviation-view", o->deviationView,
                "Colour surfaces by how far they moved from their base (|phi0| in voxels)");
+  app.add_option("--deviation-colormap", o->deviationColormap,
+                 "Colormap of the deviation view: viridis, magma, inferno, coolwarm or grey");
   app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
   app.add_option("--size", o->size, "Image size WxH (the frustum grids follow it)");
   app.add_option("--out", o->out,
@@ -119,6 +122,7 @@ Runner addOptimizeCommand(CLI::App& app) {
   return [o]() {
     resetStageTimings();
     const auto t0 = std::chrono::steady_clock::now();
+    const Colormap deviationColormap = parseColormap(o->deviationColormap);
     Engine engine(parsePrecision(o->precision));
     ExtinctionSettings s;
     s.rho = o->rho;
@@ -185,6 +189,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     rs.width = size.x;
     rs.height = size.y;
     rs.deviationView = o->deviationView;
+    rs.deviationColormap = deviationColormap;
     nlohmann::json images = nlohmann::json::object();
     if (!o->out.empty()) {
       writePng(engine.render(rs), beforePath(o->out));

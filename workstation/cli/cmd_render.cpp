@@ -18,6 +18,7 @@ double msSince(std::chrono::steady_clock::time_point t) {
 Runner addRenderCommand(CLI::App& app) {
   struct Options {
     std::string volume, scene, session, tf, size = "512x512", camera, precision = "fp32", out;
+    std::string deviationColormap = "viridis";
     int resolution = 128;
     float step = 0.5f;
     bool deviationView = false, preview = false, json = false, noJitter = false;
@@ -43,6 +44,8 @@ Runner addRenderCommand(CLI::App& app) {
   app.add_option("--step", o->step, "Ray-march step in units of the smallest voxel spacing");
   app.add_flag("--deviation-view", o->deviationView,
                "Colour context surfaces by |phi0| at the hit, in voxels (Fig. 5)");
+  app.add_option("--deviation-colormap", o->deviationColormap,
+                 "Colormap of the deviation view: viridis, magma, inferno, coolwarm or grey");
   app.add_flag("--preview", o->preview, "Low-resolution preview (1/4 size, double step)");
   app.add_flag("--no-jitter", o->noJitter, "Sample at segment midpoints (shows wood grain)");
   app.add_option("--out", o->out, "Output PNG")->required();
@@ -95,6 +98,8 @@ Runner addRenderCommand(CLI::App& app) {
     if (!session || given("--step")) settings.stepFactor = o->step;
     if (!session || o->preview) settings.preview = o->preview;
     if (!session || o->deviationView) settings.deviationView = o->deviationView;
+    if (!session || given("--deviation-colormap"))
+      settings.deviationColormap = parseColormap(o->deviationColormap);
     if (!session || o->noJitter) settings.jitter = !o->noJitter;
     RenderStats stats;
     Image image = engine.render(settings, &stats);

@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "visopt/bit_mask.h"
 #include "visopt/camera.h"
 #include "visopt/context_surface.h"
 #include "visopt/exec.h"
@@ -77,19 +78,27 @@ class Engine {
   // A surface given directly as its base SDF on the volume grid (spec.source is descriptive).
   int addContextSurface(const ContextSurfaceSpec& spec, const Field3D& baseSdf);
   void clearContextSurfaces();
+  // Removes one surface; those after it move down one index. Like adding one, this resets the
+  // optimisation. Usage error for an index out of range.
+  void removeContextSurface(int index);
   const std::vector<ContextSurfaceSpec>& contextSurfaces() const;
   void setContextSurfaceVisible(int index, bool visible);
+  // Linear RGB albedo, each component finite and >= 0 (Usage error otherwise).
+  void setContextSurfaceColor(int index, glm::vec3 rgb);
   // phi: the optimised SDF when there is one, else the base SDF; phi0: the base SDF.
   const Field3D* contextSurfacePhi(int index) const;
   const Field3D* contextSurfaceBase(int index) const;
   void setLevelSetSettings(const LevelSetSettings& settings);
   const LevelSetSettings& levelSetSettings() const;
-  // World-space mask (R5): where set, surfaces keep their base shape. A volume file on the data's
-  // grid (non-zero = masked), or a field given directly; clearWorldMask() removes it.
+  // World-space mask (R5): where set, surfaces keep their base shape. Held as bits (one per
+  // voxel, "world-mask" in the ledger) and absent when unused. A volume file on the data's grid
+  // (non-zero = masked), a bit mask whose dims are the volume grid's (Usage error otherwise), or
+  // a field on that grid (> 0.5 = masked); clearWorldMask() removes it.
   void loadWorldMask(const std::string& path);
-  void setWorldMask(Field3D mask);
+  void setWorldMask(BitMask mask);
+  void setWorldMask(const Field3D& mask);
   void clearWorldMask();
-  const Field3D* worldMask() const;
+  const BitMask* worldMask() const;
   void setLens(const ImportanceLens& lens);
   const ImportanceLens& lens() const;
   // Screen-space windowing mask (Fig. 8): weights in [0, 1] over a width x height raster that
@@ -104,6 +113,7 @@ class Engine {
   const ExtinctionSettings& extinctionSettings() const;
   // The frustum grids follow this image size (set it to the render size).
   void setViewportSize(int width, int height);
+  glm::ivec2 viewportSize() const;
   // Coarse to fine from mu_bar. The callback sees every iteration; returning false stops.
   std::vector<IterationStats> optimize(
       const std::function<bool(const IterationStats&)>& callback = {});
@@ -120,6 +130,7 @@ class Engine {
   // Render with the optimised mu (default when there is one) or with the transfer function's
   // mu_bar.
   void setRenderOptimized(bool useOptimized);
+  bool renderOptimized() const;
 
   // Renders the current scene. T_L is recomputed only when the light, the transfer function,
   // the volume or the light grid size changed since the last render.

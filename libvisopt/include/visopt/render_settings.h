@@ -5,6 +5,8 @@
 
 #include <glm/glm.hpp>
 
+#include "visopt/colormap.h"
+
 namespace visopt {
 
 // The comparison baselines of paper 000 Fig. 10, and ours.
@@ -52,10 +54,18 @@ struct RenderSettings {
   float surfaceSpecular = 0.3f, surfaceShininess = 32.f;
   bool ambientOcclusion = true;
   float ambientOcclusionRadius = 6.f;  // in voxels
-  // Deviation view (Fig. 5): colour the surfaces by |phi0| at the hit, in voxels, through a
-  // colormap over [0, deviationMaxVoxels].
+  // Deviation view (Fig. 5): colour the surfaces by |phi0| at the hit, in voxels, through
+  // deviationColormap over [0, deviationMaxVoxels].
   bool deviationView = false;
   float deviationMaxVoxels = 10.f;
+  Colormap deviationColormap = Colormap::Viridis;
+
+  // Workstation overlays, off by default (and then without any effect on the image).
+  // importanceOverlay in [0, 1]: each volume sample's albedo is blended towards a highlight
+  // colour by g(x) * importanceOverlay (needs an importance). worldMaskOverlay: volume samples
+  // and surface points in a voxel of the world mask are tinted magenta (40 %).
+  float importanceOverlay = 0.f;
+  bool worldMaskOverlay = false;
 };
 
 struct RenderStats {

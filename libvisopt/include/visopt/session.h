@@ -20,6 +20,7 @@
 
 #include <glm/glm.hpp>
 
+#include "visopt/bit_mask.h"
 #include "visopt/camera.h"
 #include "visopt/engine.h"
 #include "visopt/level_set.h"
@@ -76,17 +77,9 @@ DataResolution resolveDataReference(const DataReference& ref, const std::string&
 
 // ---- the session ---------------------------------------------------------------------------
 
-// A binary mask on the volume grid, bit-packed: bit i (x fastest, LSB first) is voxel i.
-struct SessionMask {
-  glm::ivec3 dims{0};
-  std::vector<uint8_t> bits;  // (voxelCount + 7) / 8 bytes
-  size_t voxelCount() const;
-  bool get(size_t i) const { return (bits[i >> 3] >> (i & 7)) & 1u; }
-  void set(size_t i, bool v);
-  bool operator==(const SessionMask&) const = default;
-};
-// Set where the field is > 0.5 (the level-set step's threshold).
-SessionMask packMask(const Field3D& mask);
+// The world mask of a session: a bit-packed mask on the volume grid (visopt/bit_mask.h, which
+// also declares packMask).
+using SessionMask = BitMask;
 
 struct SessionImportance {
   enum class Kind { None, Scene, Curve, Volume } kind = Kind::None;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 
+#include "core/device_bit_mask.h"
 #include "core/device_buffer.h"
 #include "engine/context_surfaces.h"
 #include "engine/importance.h"
@@ -40,7 +41,8 @@ struct Engine::Impl {
   std::vector<ContextSurfaceSpec> surfaceSpecs;
   std::vector<Field3D> surfaceBases;
   LevelSetSettings levelSet;
-  std::optional<Field3D> worldMask;
+  std::optional<BitMask> worldMask;             // what worldMask() returns
+  std::optional<DeviceBitMask> worldMaskWords;  // the same bits for the kernels
   ImportanceLens lens;
   std::optional<Field3D> screenMask;
   ExtinctionSettings extinctionSettings;
@@ -58,6 +60,7 @@ struct Engine::Impl {
     surfaceSpecs.clear();
     surfaceBases.clear();
     worldMask.reset();
+    worldMaskWords.reset();
     volume.reset();
     frozen = false;
   }
@@ -78,7 +81,7 @@ struct Engine::Impl {
     in.imageHeight = viewportHeight;
     for (const auto& b : surfaceBases) in.surfaceBases.push_back(&b);
     in.levelSet = levelSet;
-    in.worldMask = worldMask ? &*worldMask : nullptr;
+    in.worldMask = worldMaskWords ? &*worldMaskWords : nullptr;
     in.lens = lens;
     in.screenMask = screenMask ? &*screenMask : nullptr;
     return in;
@@ -129,6 +132,7 @@ struct Engine::Impl {
     }
     s.importanceBehind = optimizer.importanceBehind();
     s.importance = importance ? &*importance : nullptr;
+    if (worldMaskWords) s.worldMask = worldMaskWords->view();
     if (lightTransmittance) {
       s.lightFrustum = &lightFrustum;
       s.lightTransmittance = &*lightTransmittance;
@@ -299,6 +303,24 @@ void Engine::clearContextSurfaces() {
   impl_->lightDirty = true;
 }
 
+void Engine::removeContextSurface(int index) {
+  if (index < 0 || index >= int(impl_->surfaceSpecs.size()))
+    throw Error(ErrorKind::Usage, "no context surface " + std::to_string(index));
+  impl_->surfaceSpecs.erase(impl_->surfaceSpecs.begin() + index);
+  impl_->surfaceBases.erase(impl_->surfaceBases.begin() + index);
+  impl_->optimizer.reset();
+  impl_->lightDirty = true;
+}
+
+void Engine::setContextSurfaceColor(int index, glm::vec3 rgb) {
+  if (index < 0 || index >= int(impl_->surfaceSpecs.size()))
+    throw Error(ErrorKind::Usage, "no context surface " + std::to_string(index));
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(rgb[c]) || rgb[c] < 0.f)
+      throw Error(ErrorKind::Usage, "a surface colour must be finite and non-negative");
+  impl_->surfaceSpecs[size_t(index)].color = rgb;
+}
+
 const std::vector<ContextSurfaceSpec>& Engine::contextSurfaces() const {
   return impl_->surfaceSpecs;
 }
@@ -334,25 +356,41 @@ void Engine::loadWorldMask(const std::string& path) {
   Volume m = readVolume(path, Precision::FP32, nullptr);
   if (m.grid().dims != impl_->volume->grid().dims)
     throwBadInput(path, "the mask's dimensions differ from the data's");
-  Field3D mask("world-mask", impl_->volume->grid(), impl_->precision, nullptr);
-  for (size_t i = 0; i < mask.size(); ++i)
-    mask.set(i, m.toValue(m.normalized.get(i)) != 0.0 ? 1.f : 0.f);
+  BitMask mask = BitMask::cleared(m.grid().dims);
+  for (size_t i = 0; i < m.normalized.size(); ++i)
+    if (m.toValue(m.normalized.get(i)) != 0.0) mask.set(i, true);
   setWorldMask(std::move(mask));
 }
 
-void Engine::setWorldMask(Field3D mask) {
+void Engine::setWorldMask(BitMask mask) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before a mask");
+  const glm::ivec3 d = impl_->volume->grid().dims;
+  if (mask.dims != d)
+    throw Error(ErrorKind::Usage, "the mask's dimensions " + std::to_string(mask.dims.x) + "x" +
+                                      std::to_string(mask.dims.y) + "x" +
+                                      std::to_string(mask.dims.z) + " differ from the volume's " +
+                                      std::to_string(d.x) + "x" + std::to_string(d.y) + "x" +
+                                      std::to_string(d.z));
+  if (mask.bits.size() != (mask.voxelCount() + 7) / 8)
+    throw Error(ErrorKind::Usage, "the mask holds " + std::to_string(mask.bits.size()) +
+                                      " bytes, not one bit per voxel");
+  impl_->worldMaskWords.reset();
+  impl_->worldMaskWords.emplace(mask, "world-mask", &impl_->ledger);
+  impl_->worldMask = std::move(mask);
+}
+
+void Engine::setWorldMask(const Field3D& mask) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before a mask");
   if (mask.grid().dims != impl_->volume->grid().dims)
     throw Error(ErrorKind::Usage, "the mask must be on the volume's grid");
-  impl_->worldMask.reset();
-  impl_->worldMask.emplace("world-mask", impl_->volume->grid(), impl_->precision, &impl_->ledger);
-  for (size_t i = 0; i < mask.size(); ++i) impl_->worldMask->set(i, mask.get(i));
+  setWorldMask(packMask(mask));
 }
 
 void Engine::clearWorldMask() {
+  impl_->worldMaskWords.reset();
   impl_->worldMask.reset();
 }
-const Field3D* Engine::worldMask() const {
+const BitMask* Engine::worldMask() const {
   return impl_->worldMask ? &*impl_->worldMask : nullptr;
 }
 
@@ -433,6 +471,9 @@ void Engine::setViewportSize(int width, int height) {
   impl_->viewportWidth = width;
   impl_->viewportHeight = height;
 }
+glm::ivec2 Engine::viewportSize() const {
+  return {impl_->viewportWidth, impl_->viewportHeight};
+}
 
 std::vector<IterationStats> Engine::optimize(
     const std::function<bool(const IterationStats&)>& callback) {
@@ -474,6 +515,9 @@ const Field3D* Engine::optimizedExtinction() const {
 void Engine::setRenderOptimized(bool useOptimized) {
   if (impl_->renderOptimized != useOptimized) impl_->lightDirty = true;
   impl_->renderOptimized = useOptimized;
+}
+bool Engine::renderOptimized() const {
+  return impl_->renderOptimized;
 }
 
 }  // namespace visopt

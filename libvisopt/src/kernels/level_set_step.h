@@ -22,6 +22,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/bit_mask_view.h"
 #include "core/field_view.h"
 #include "core/half.h"
 #include "core/hd.h"
@@ -236,10 +237,8 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
 template <class A, int Order>
 struct LevelSetStepKernel {
   A phi, out, phi0, ghat;
-  // The world mask: masked where mask > maskThreshold. Without a mask, `mask` reads ghat and
-  // the threshold is infinite (one code path, no conditional loads).
-  A mask;
-  float maskThreshold = 3.4e38f;
+  // The world mask, one bit per voxel (invalid: nothing masked).
+  BitMaskView mask;
   glm::ivec3 dims{1};
   glm::vec3 spacing{1.f};
   float dt = 0.f;
@@ -259,7 +258,7 @@ struct LevelSetStepKernel {
     const float ym = phi.load(size_t(s + ay.m)), yp = phi.load(size_t(s + ay.p));
     const float zm = phi.load(size_t(s + az.m)), zp = phi.load(size_t(s + az.p));
     const float g = ghat.load(v);
-    const bool masked = mask.load(v) > maskThreshold;
+    const bool masked = mask.valid() && mask.get(v);
 
     const OneSided dx = oneSided(xm, c, xp, ax), dy = oneSided(ym, c, yp, ay),
                    dz = oneSided(zm, c, zp, az);

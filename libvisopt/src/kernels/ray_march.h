@@ -335,7 +335,7 @@ struct RayMarchKernel {
         const float opticalDepth = mu * seg;
         if (opticalDepth < kRayMinOpticalDepth) continue;
         const float alpha = raySegmentAlpha(opticalDepth);
-        const glm::vec3 albedo = p.transfer.albedo(entry);
+        const glm::vec3 albedo = overlayAlbedo(p.surf, idx, p.transfer.albedo(entry), true);
 
         // Direction and distance to the light from x = eye + t dir.
         const glm::vec3 fromLight = lr.e + t * dir;

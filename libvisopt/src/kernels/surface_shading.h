@@ -1,7 +1,7 @@
 // Shading of the context surfaces (paper 000 Eq. 8 and §III-E): the reduced surface radiance
 //   L_r = T_V f_r (n . wL)+ L_i,  L_i = T_L L_e  (Eq. 9),
-// with a normalised Blinn-Phong BRDF f_r, ambient occlusion from the SDF and from the volume,
-// and the deviation view's colormap (Fig. 5).
+// with a normalised Blinn-Phong BRDF f_r, ambient occlusion from the SDF and from the volume. The
+// deviation view's colormaps live in core/colormap_eval.h.
 #pragma once
 
 #include <cmath>
@@ -54,19 +54,6 @@ VISOPT_HD inline float sdfOcclusion(const SurfaceSet& surfaces, const GridMap& g
     weight *= 0.5f;
   }
   return fminf(fmaxf(1.f - occlusion, 0.f), 1.f);
-}
-
-// A perceptually ordered colormap (viridis-like, 5 control points) for the deviation view.
-VISOPT_HD inline glm::vec3 deviationColor(float t) {
-  const glm::vec3 c[5] = {glm::vec3(0.267f, 0.005f, 0.329f), glm::vec3(0.229f, 0.322f, 0.546f),
-                          glm::vec3(0.128f, 0.567f, 0.551f), glm::vec3(0.369f, 0.789f, 0.383f),
-                          glm::vec3(0.993f, 0.906f, 0.144f)};
-  t = fminf(fmaxf(t, 0.f), 1.f) * 4.f;
-  const int i = t >= 4.f ? 3 : int(t);
-  const float f = t - float(i);
-  // sRGB control points; the renderer works in linear light.
-  const glm::vec3 srgb = c[i] + f * (c[i + 1] - c[i]);
-  return glm::vec3(powf(srgb.x, 2.2f), powf(srgb.y, 2.2f), powf(srgb.z, 2.2f));
 }
 
 }  // namespace visopt

@@ -143,7 +143,8 @@ struct ExtinctionOptimizer::Level {
   // Context surfaces: phi per surface, phi0 on coarse levels (the finest uses the inputs'),
   // the world mask on coarse levels, ghat, the frustum maxima of g and level-set scratch.
   std::vector<Field3D> phi, phi0;
-  std::optional<Field3D> mask, ghat, viewMax, lightMax, scratch;
+  std::optional<DeviceBitMask> mask;
+  std::optional<Field3D> ghat, viewMax, lightMax, scratch;
   FrustumGrid view, light;
   int shrink = 1;  // frustum grids are this many times coarser than at the finest level
   int t = 0;       // optimiser steps taken on this level
@@ -201,6 +202,29 @@ void resample(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
               k = int(v / (int64_t(map.dims.x) * map.dims.y));
     to.store(size_t(v),
              from.sample(srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))))));
+  });
+}
+
+// The world mask on a coarser grid: a coarse voxel is masked where the trilinear interpolation
+// of the fine 0/1 mask at its centre exceeds 0.5 (what resampling the mask as a field and
+// thresholding it gave). One work item per output byte, so no two write the same word.
+void resampleMask(const DeviceBitMask& src, const GridMap& srcMap, DeviceBitMask& dst,
+                  const GridSpec& dstGrid) {
+  const BitMaskView from = src.view();
+  uint8_t* to = dst.words();
+  const GridMap map(dstGrid);
+  const int64_t voxels = int64_t(dstGrid.voxelCount());
+  exec::parallelFor("multigrid resample mask", int64_t(dst.bytes()), [=] VISOPT_HD(int64_t b) {
+    unsigned word = 0;
+    for (int bit = 0; bit < 8; ++bit) {
+      const int64_t v = b * 8 + bit;
+      if (v >= voxels) break;
+      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
+                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+      const glm::vec3 p = srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))));
+      if (from.sample(p) > 0.5f) word |= 1u << bit;
+    }
+    to[b] = static_cast<uint8_t>(word);
   });
 }
 
@@ -336,8 +360,8 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     next->ghat.emplace("importance-behind", grid, precision_, ledger_);
     next->scratch.emplace("surface-scratch", grid, precision_, ledger_);
     if (in.worldMask && !next->finest) {
-      next->mask.emplace("world-mask (coarse)", grid, precision_, ledger_);
-      resample(*in.worldMask, fineMap, *next->mask);
+      next->mask.emplace(grid.dims, "world-mask (coarse)", ledger_);
+      resampleMask(*in.worldMask, fineMap, *next->mask, grid);
     }
   }
   level_.reset();
@@ -504,7 +528,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
             lightMax.valid() ? 0.5f * vm + 0.5f * gatherFrustum(light, lightMax, x) : vm;
         ghat.store(size_t(v), fminf(fmaxf(g, 0.f), 1.f));
       });
-  const Field3D* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
+  const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   LevelSetStepStats ls;
   for (size_t si = 0; si < L.phi.size(); ++si) {
     const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];

@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/device_bit_mask.h"
 #include "core/device_buffer.h"
 #include "visopt/camera.h"
 #include "visopt/field.h"
@@ -31,7 +32,7 @@ struct OptimizationInputs {
   // Context surfaces: base SDFs phi0 on the volume grid (filled, or already a thin shell).
   std::vector<const Field3D*> surfaceBases;
   LevelSetSettings levelSet;
-  const Field3D* worldMask = nullptr;  // > 0.5: surfaces keep their base shape there
+  const DeviceBitMask* worldMask = nullptr;  // set: surfaces keep their base shape there
   ImportanceLens lens;
   const Field3D* screenMask = nullptr;  // width x height x 1 weights, row 0 at the top
 };

@@ -11,15 +11,17 @@
 namespace visopt {
 
 class MemoryLedger;
+class DeviceBitMask;
 
 // s.substeps explicit Euler substeps of Eq. 23 on phi (in place; `scratch` is the second
 // buffer, (re)allocated like phi when it does not match phi's grid and precision). Each
 // substep's dt = s.cfl x min(dx / max|grad ghat|, dx^2 / (6 max ghat), 1 / max lambda(x)),
 // dx the smallest spacing; terms whose maximum is 0 drop out, and dt is at most s.cfl x dx^2
-// (world units) when all of them do. s.cfl is clamped to (0, 1]. `mask` (nullable; > 0.5 =
+// (world units) when all of them do. s.cfl is clamped to (0, 1]. `mask` (nullable; a set bit =
 // masked) turns the occlusion term off. phi0, ghat and mask must be on phi's grid.
 LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                               const Field3D* mask, const LevelSetSettings& s, Field3D& scratch);
+                               const DeviceBitMask* mask, const LevelSetSettings& s,
+                               Field3D& scratch);
 
 // The stable dt levelSetStep would use (the same formula), for tests and callers.
 double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s);
@@ -35,7 +37,8 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
 // into `out` (returns max |delta phi|), and one redistancing iteration from `in` into `out`
 // (returns the mean squared change in voxel units^2; the interface band is copied).
 double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                       const Field3D* mask, const LevelSetSettings& s, double dt, Field3D& out);
+                       const DeviceBitMask* mask, const LevelSetSettings& s, double dt,
+                       Field3D& out);
 double redistanceIteration(const Field3D& in, Field3D& out, int spatialOrder = 2);
 
 // phi(x, 0) = +-(s(x) - iso) / |grad s| (inside negative: with insideHigh, values above the

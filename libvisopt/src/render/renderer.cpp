@@ -157,6 +157,7 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   }
   p.surf.deviationView = settings.deviationView;
   p.surf.deviationScale = 1.f / (grid.minSpacing() * std::max(settings.deviationMaxVoxels, 1e-3f));
+  p.surf.deviationColormap = settings.deviationColormap;
   p.surf.ks = settings.surfaceSpecular;
   p.surf.shininess = settings.surfaceShininess;
   p.surf.ambientOcclusion = settings.ambientOcclusion;
@@ -170,6 +171,10 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   if (scene.importanceBehind) p.surf.importanceBehind = FieldView(*scene.importanceBehind);
   if (scene.importance) p.surf.importance = FieldView(*scene.importance);
   p.surf.cutThreshold = settings.cutAwayThreshold;
+  // Overlays; NaN or <= 0 leaves the importance overlay off.
+  p.surf.importanceOverlay =
+      settings.importanceOverlay > 0.f ? std::min(settings.importanceOverlay, 1.f) : 0.f;
+  if (settings.worldMaskOverlay) p.surf.worldMask = scene.worldMask;
 
   SkipGridStorage skip;
   buildSkipGrid(scene, p.step, skip);

@@ -5,6 +5,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/bit_mask_view.h"
 #include "core/device_buffer.h"
 #include "visopt/camera.h"
 #include "visopt/field.h"
@@ -29,6 +30,7 @@ struct RenderScene {
   // For the comparison baselines: ghat (Eq. 19) and g on the volume grid.
   const Field3D* importanceBehind = nullptr;
   const Field3D* importance = nullptr;
+  BitMaskView worldMask;  // for the world-mask overlay; invalid without a mask
 };
 
 // T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h).

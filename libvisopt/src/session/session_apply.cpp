@@ -106,8 +106,15 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
   if (!session.builtinScene.empty()) {
     SessionDataReport d{"volume", {}, DataStatus::Ok, "builtin:" + session.builtinScene, {}};
     d.reference.absolutePath = d.resolvedPath;
-    if (!attempt([&] { engine.loadBuiltinScene(session.builtinScene, session.builtinResolution); },
-                 d.message))
+    // The scene's own surfaces only when the session says nothing of surfaces or transfer
+    // function (a hand-written one); a captured session lists every surface it had.
+    const bool sceneSurfaces = session.contextSurfaces.empty() && !session.transferFunction;
+    if (!attempt(
+            [&] {
+              engine.loadBuiltinScene(session.builtinScene, session.builtinResolution,
+                                      sceneSurfaces);
+            },
+            d.message))
       d.status = DataStatus::Missing;
     report.data.push_back(d);
     if (d.status != DataStatus::Ok) return report;
@@ -186,9 +193,7 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
     if (m.dims != grid.dims) {
       report.warnings.push_back("world mask: its dims differ from the volume's; not applied");
     } else {
-      Field3D field("world-mask", grid, Precision::FP32, nullptr);
-      for (size_t v = 0; v < field.size(); ++v) field.set(v, m.get(v) ? 1.f : 0.f);
-      warnIfFails("world mask", [&] { engine.setWorldMask(std::move(field)); });
+      warnIfFails("world mask", [&] { engine.setWorldMask(m); });
     }
   }
   engine.setFrozen(session.frozen);

@@ -57,7 +57,7 @@ Session captureSession(const Engine& engine, const RenderSettings& render,
   s.lens = engine.lens();
   s.render = render;
   s.frozen = engine.frozen();
-  if (const Field3D* mask = engine.worldMask()) s.worldMask = packMask(*mask);
+  if (const BitMask* mask = engine.worldMask()) s.worldMask = *mask;
   return s;
 }
 

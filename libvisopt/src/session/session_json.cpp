@@ -186,8 +186,18 @@ void readCurrent(const json& doc, Session& s, const Where& top) {
   }
   if (auto it = doc.find("lens"); it != doc.end())
     session::lensFields().read(*it, s.lens, top.key("lens"));
-  if (auto it = doc.find("render"); it != doc.end())
+  if (auto it = doc.find("render"); it != doc.end()) {
     session::renderFields().read(*it, s.render, top.key("render"));
+    if (auto c = it->find("deviationColormap"); c != it->end()) {
+      std::string name;
+      session::readValue(*c, name, top.key("render").key("deviationColormap"));
+      try {
+        s.render.deviationColormap = parseColormap(name);
+      } catch (const Error&) {
+        top.key("render").key("deviationColormap").fail("unknown colormap \"" + name + "\"");
+      }
+    }
+  }
   session::readOptional(doc, "frozen", s.frozen, top);
   if (auto it = doc.find("worldMask"); it != doc.end())
     s.worldMask = maskFromJson(*it, top.key("worldMask"));
@@ -242,7 +252,12 @@ std::string sessionToJson(const Session& s, const std::string& sessionPath) {
   if (s.camera) doc["camera"] = session::cameraFields().writeAll(*s.camera);
   if (s.light) doc["light"] = session::lightFields().writeAll(*s.light);
   putIfNotEmpty(doc, "lens", session::lensFields().write(s.lens));
-  putIfNotEmpty(doc, "render", session::renderFields().write(s.render));
+  {
+    OrderedJson render = session::renderFields().write(s.render);
+    if (s.render.deviationColormap != RenderSettings{}.deviationColormap)
+      render["deviationColormap"] = toString(s.render.deviationColormap);
+    putIfNotEmpty(doc, "render", std::move(render));
+  }
   if (s.frozen) doc["frozen"] = true;
   if (s.worldMask) doc["worldMask"] = maskToJson(*s.worldMask);
   return doc.dump(2) + "\n";

@@ -76,7 +76,9 @@ const FieldTable<RenderSettings>& renderFields() {
                                 .add("ambientOcclusion", &S::ambientOcclusion)
                                 .add("ambientOcclusionRadius", &S::ambientOcclusionRadius)
                                 .add("deviationView", &S::deviationView)
-                                .add("deviationMaxVoxels", &S::deviationMaxVoxels);
+                                .add("deviationMaxVoxels", &S::deviationMaxVoxels)
+                                .add("importanceOverlay", &S::importanceOverlay)
+                                .add("worldMaskOverlay", &S::worldMaskOverlay);
   return table;
 }
 

@@ -1,0 +1,141 @@
+// Engine facade additions the workstation uses: removing a context surface, recolouring one,
+// and reading back the render-optimised flag and the viewport size.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "render_fixtures.h"
+#include "visopt/engine.h"
+#include "visopt/error.h"
+
+using namespace visopt;
+using namespace visopt::testing;
+
+namespace {
+
+// A sphere SDF of `radius` about `centre` on the volume grid.
+Field3D sphereSdf(const GridSpec& g, glm::vec3 centre, float radius) {
+  Field3D phi("sphere", g, Precision::FP32);
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = 0; j < g.dims.y; ++j)
+      for (int i = 0; i < g.dims.x; ++i)
+        phi.set(
+            g.linearIndex(i, j, k),
+            glm::length(g.indexToWorld(glm::vec3(float(i), float(j), float(k))) - centre) - radius);
+  return phi;
+}
+
+// An empty volume of 33^3 unit voxels seen along -z from far away, lit from the eye; no AO or
+// specular, so a surface facing the eye shows colour * 3 / pi.
+void emptyScene(Engine& e) {
+  e.setVolume(homogeneousCube(33));
+  e.setTransferFunction(constantTransferFunction(0.f, glm::vec3(1.f)));
+  Camera cam = Camera::orbit({0, 0, 0}, 0.f, 0.f, 100.f);
+  e.setCamera(cam);
+  PointLight light;
+  light.position = cam.eye;
+  light.intensity = 3.f;
+  e.setLight(light);
+}
+
+RenderSettings surfaceOnly() {
+  RenderSettings s = pureSingleScattering(33);
+  s.surfaceSpecular = 0.f;
+  s.ambientOcclusion = false;
+  return s;
+}
+
+ContextSurfaceSpec specNamed(const std::string& name, glm::vec3 colour) {
+  ContextSurfaceSpec spec;
+  spec.source = name;
+  spec.color = colour;
+  return spec;
+}
+
+}  // namespace
+
+TEST(EngineApi, RemoveContextSurfaceShiftsTheOthersDown) {
+  Engine e;
+  emptyScene(e);
+  const GridSpec& g = e.volume().grid();
+  // Three small spheres side by side along x (left, middle, right).
+  e.addContextSurface(specNamed("left", glm::vec3(1, 0, 0)), sphereSdf(g, {-10, 0, 0}, 4.f));
+  e.addContextSurface(specNamed("middle", glm::vec3(0, 1, 0)), sphereSdf(g, {0, 0, 0}, 4.f));
+  e.addContextSurface(specNamed("right", glm::vec3(0, 0, 1)), sphereSdf(g, {10, 0, 0}, 4.f));
+  const Image before = e.render(surfaceOnly());
+
+  e.removeContextSurface(1);
+  ASSERT_EQ(e.contextSurfaces().size(), 2u);
+  EXPECT_EQ(e.contextSurfaces()[0].source, "left");
+  EXPECT_EQ(e.contextSurfaces()[1].source, "right");
+  ASSERT_NE(e.contextSurfaceBase(1), nullptr);
+  EXPECT_EQ(e.contextSurfaceBase(2), nullptr);
+  // The base now at index 1 is the right sphere's: phi0 = -4 at its centre (index 26,16,16).
+  EXPECT_NEAR(e.contextSurfaceBase(1)->get(g.linearIndex(26, 16, 16)), -4.f, 1e-5f);
+
+  const Image after = e.render(surfaceOnly());
+  // Seen from (0, -100, 0) with a 30 degree field of view, 33 pixels span 53.6 world units at
+  // the spheres: their centres land near columns 16 -+ 6.2, radii 2.5 pixels. The middle one
+  // is gone (background, 0); columns at least 4 from the centre are untouched.
+  EXPECT_GT(before.at(16, 16).y, 0.1f);
+  EXPECT_NEAR(after.at(16, 16).y, 0.f, 1e-6f);
+  float outer = 0.f;
+  for (int y = 0; y < 33; ++y)
+    for (int x = 0; x < 33; ++x) {
+      if (std::abs(x - 16) < 4) {
+        EXPECT_NEAR(after.at(x, y).y, 0.f, 1e-6f) << x << "," << y;
+        continue;
+      }
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(after.at(x, y)[c], before.at(x, y)[c], 1e-5f) << x << "," << y;
+      outer += after.at(x, y).x + after.at(x, y).z;
+    }
+  EXPECT_GT(outer, 1.f) << "the outer spheres should still be drawn";
+
+  for (int bad : {-1, 2, 7}) EXPECT_THROW(e.removeContextSurface(bad), Error) << bad;
+  e.removeContextSurface(0);
+  e.removeContextSurface(0);
+  EXPECT_TRUE(e.contextSurfaces().empty());
+  const Image none = e.render(surfaceOnly());
+  for (const glm::vec3& px : none.pixels) EXPECT_EQ(px, glm::vec3(0.f));
+}
+
+TEST(EngineApi, SetContextSurfaceColorRecolours) {
+  Engine e;
+  emptyScene(e);
+  e.addContextSurface(specNamed("sphere", glm::vec3(0.8f)),
+                      sphereSdf(e.volume().grid(), glm::vec3(0.f), 10.f));
+  const glm::vec3 colour(0.9f, 0.3f, 0.05f);
+  e.setContextSurfaceColor(0, colour);
+  EXPECT_EQ(e.contextSurfaces()[0].color, colour);
+  const Image img = e.render(surfaceOnly());
+  // Facing the eye with the light at the eye: colour * L_e / pi (Eq. 8, Lambertian).
+  const float pi = 3.14159265f;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(img.at(16, 16)[c], colour[c] * 3.f / pi, 0.03f * colour[c] * 3.f / pi + 1e-3f) << c;
+  EXPECT_THROW(e.setContextSurfaceColor(1, colour), Error);
+  EXPECT_THROW(e.setContextSurfaceColor(-1, colour), Error);
+  EXPECT_THROW(e.setContextSurfaceColor(0, glm::vec3(-0.1f, 0.f, 0.f)), Error);
+  EXPECT_THROW(e.setContextSurfaceColor(0, glm::vec3(std::nanf(""), 0.f, 0.f)), Error);
+  EXPECT_EQ(e.contextSurfaces()[0].color, colour) << "a rejected colour must not stick";
+}
+
+TEST(EngineApi, RenderOptimizedAndViewportSizeReadBack) {
+  Engine e;
+  EXPECT_TRUE(e.renderOptimized());
+  e.setRenderOptimized(false);
+  EXPECT_FALSE(e.renderOptimized());
+  e.setRenderOptimized(true);
+  EXPECT_TRUE(e.renderOptimized());
+
+  EXPECT_EQ(e.viewportSize(), glm::ivec2(512, 512));
+  e.setViewportSize(320, 200);
+  EXPECT_EQ(e.viewportSize(), glm::ivec2(320, 200));
+  try {
+    e.setViewportSize(0, 10);
+    ADD_FAILURE() << "accepted a zero width";
+  } catch (const Error& err) {
+    EXPECT_EQ(err.kind(), ErrorKind::Usage);
+  }
+  EXPECT_EQ(e.viewportSize(), glm::ivec2(320, 200));
+}

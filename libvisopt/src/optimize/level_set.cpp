@@ -5,7 +5,10 @@
 #include <cstdint>
 #include <limits>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "core/device_bit_mask.h"
 #include "core/field_view.h"
 #include "exec/parallel.h"
 #include "kernels/level_set_step.h"
@@ -106,15 +109,15 @@ float checkedCfl(const LevelSetSettings& s) {
 
 template <class A, int Order>
 ChangeSums substepWith(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                       const Field3D* mask, const LevelSetSettings& s, float dt, Field3D& out) {
+                       const DeviceBitMask* mask, const LevelSetSettings& s, float dt,
+                       Field3D& out) {
   const GridSpec& g = phi.grid();
   LevelSetStepKernel<A, Order> k;
   k.phi = accessOf(phi, Tag<A>{});
   k.out = accessOf(out, Tag<A>{});
   k.phi0 = accessOf(phi0, Tag<A>{});
   k.ghat = accessOf(ghat, Tag<A>{});
-  k.mask = accessOf(mask ? *mask : ghat, Tag<A>{});
-  k.maskThreshold = mask ? 0.5f : 3.4e38f;
+  if (mask) k.mask = mask->view();
   k.dims = g.dims;
   k.spacing = g.spacing;
   k.dt = dt;
@@ -125,8 +128,8 @@ ChangeSums substepWith(const Field3D& phi, const Field3D& phi0, const Field3D& g
 }
 
 ChangeSums substep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                   const Field3D* mask, const LevelSetSettings& s, float dt, Field3D& out) {
-  return dispatch({&phi, &phi0, &ghat, &out, mask ? mask : &phi}, [&](auto tag) {
+                   const DeviceBitMask* mask, const LevelSetSettings& s, float dt, Field3D& out) {
+  return dispatch({&phi, &phi0, &ghat, &out}, [&](auto tag) {
     using A = typename decltype(tag)::type;
     return s.spatialOrder == 1 ? substepWith<A, 1>(phi, phi0, ghat, mask, s, dt, out)
                                : substepWith<A, 2>(phi, phi0, ghat, mask, s, dt, out);
@@ -177,16 +180,19 @@ double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s) {
 }
 
 double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                       const Field3D* mask, const LevelSetSettings& s, double dt, Field3D& out) {
+                       const DeviceBitMask* mask, const LevelSetSettings& s, double dt,
+                       Field3D& out) {
   return double(substep(phi, phi0, ghat, mask, s, float(dt), out).maxAbs);
 }
 
 LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                               const Field3D* mask, const LevelSetSettings& s, Field3D& scratch) {
+                               const DeviceBitMask* mask, const LevelSetSettings& s,
+                               Field3D& scratch) {
   requireSameGrid(phi, phi, "phi");
   requireSameGrid(phi, phi0, "the base SDF phi0");
   requireSameGrid(phi, ghat, "ghat");
-  if (mask) requireSameGrid(phi, *mask, "the world mask");
+  if (mask && mask->dims() != phi.grid().dims)
+    throw Error(ErrorKind::Usage, "level set: the world mask is not on the level set's grid");
   if (s.substeps < 0) throw Error(ErrorKind::Usage, "level set: substeps must be >= 0");
   checkOrder(s);
   ensureLike(scratch, phi);
@@ -274,6 +280,73 @@ struct IsoGradientKernel {
   }
 };
 
+// Zhao's fast sweeping (Math. Comp. 74, 2005) for |grad d| = 1 from a fixed band: Gauss-Seidel
+// sweeps in the 8 diagonal orderings, each voxel taking the smaller of its value and the
+// first-order Godunov (upwind) solution from its face neighbours, with the grid's own spacing
+// per axis. Rounds of 8 sweeps repeat until a round changes nothing by more than `tolerance`
+// (world units; cavities and concave parts need a few). Host code: it runs once per base SDF.
+void fastSweep(std::vector<float>& d, const std::vector<uint8_t>& fixed, glm::ivec3 dims,
+               glm::vec3 spacing, float tolerance, int maxRounds) {
+  const int64_t nx = dims.x, ny = dims.y, nz = dims.z;
+  const double w[3] = {1.0 / (double(spacing.x) * spacing.x), 1.0 / (double(spacing.y) * spacing.y),
+                       1.0 / (double(spacing.z) * spacing.z)};
+  const double hs[3] = {spacing.x, spacing.y, spacing.z};
+  const float inf = std::numeric_limits<float>::infinity();
+  auto update = [&](int64_t i, int64_t j, int64_t k) -> float {
+    const int64_t v = i + nx * (j + ny * k);
+    const float c = d[size_t(v)];
+    std::pair<double, int> a[3];
+    const float ax = std::min(i > 0 ? d[size_t(v - 1)] : inf, i + 1 < nx ? d[size_t(v + 1)] : inf);
+    const float ay =
+        std::min(j > 0 ? d[size_t(v - nx)] : inf, j + 1 < ny ? d[size_t(v + nx)] : inf);
+    const float az =
+        std::min(k > 0 ? d[size_t(v - nx * ny)] : inf, k + 1 < nz ? d[size_t(v + nx * ny)] : inf);
+    a[0] = {ax, 0};
+    a[1] = {ay, 1};
+    a[2] = {az, 2};
+    std::sort(a, a + 3);
+    if (!(a[0].first < double(c))) return c;  // no smaller neighbour
+    // One term, then two, then three, while the solution exceeds the next neighbour.
+    double u = a[0].first + hs[a[0].second];
+    double sw = 0.0, swa = 0.0, swa2 = 0.0;
+    for (int m = 0; m < 3; ++m) {
+      if (m > 0 && !(u > a[m].first)) break;
+      const double wm = w[a[m].second];
+      sw += wm;
+      swa += wm * a[m].first;
+      swa2 += wm * a[m].first * a[m].first;
+      if (m == 0) continue;
+      const double disc = swa * swa - sw * (swa2 - 1.0);
+      if (disc < 0.0) break;  // cannot happen for sorted finite a; keep the previous u
+      u = (swa + std::sqrt(disc)) / sw;
+    }
+    return std::min(c, float(u));
+  };
+  for (int round = 0; round < maxRounds; ++round) {
+    float change = 0.f;
+    for (int dir = 0; dir < 8; ++dir) {
+      const bool fx = dir & 1, fy = dir & 2, fz = dir & 4;
+      for (int64_t kk = 0; kk < nz; ++kk) {
+        const int64_t k = fz ? nz - 1 - kk : kk;
+        for (int64_t jj = 0; jj < ny; ++jj) {
+          const int64_t j = fy ? ny - 1 - jj : jj;
+          for (int64_t ii = 0; ii < nx; ++ii) {
+            const int64_t i = fx ? nx - 1 - ii : ii;
+            const size_t v = size_t(i + nx * (j + ny * k));
+            if (fixed[v]) continue;
+            const float u = update(i, j, k);
+            if (u < d[v]) {
+              change = std::max(change, std::isinf(d[v]) ? inf : d[v] - u);
+              d[v] = u;
+            }
+          }
+        }
+      }
+    }
+    if (change <= tolerance) break;
+  }
+}
+
 }  // namespace
 
 Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
@@ -303,13 +376,57 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
       dst.store(size_t(v), fminf(fmaxf(d, -far), far));
     });
   }
-  // Converge everywhere: the corrections travel half a voxel per iteration from the interface.
-  LevelSetSettings r = s;
-  const int crossing = int(std::ceil(2.0 * double(g.diagonal()) / double(g.minSpacing()))) + 8;
-  r.redistanceIterations = std::max(s.redistanceIterations, crossing);
-  r.redistanceTolerance = std::min(s.redistanceTolerance, 1e-6f);
+  // The distance away from the interface by fast sweeping, then redistancing (Eq. 18) only to
+  // polish. Redistancing alone from s - iso needs enough iterations for the front to cross the
+  // grid (corrections travel half a voxel per iteration): 800 on a 256^2 x 108 CT. Here:
+  //  1. one redistancing pass with the subcell fix sets the voxels next to the interface to
+  //     their subcell distance (kernels/redistance.h), exactly as the first iteration would;
+  //  2. fast sweeping propagates |phi| from that band to the whole grid (first order, exact for
+  //     planes, within a fraction of a voxel elsewhere), the sign is the start field's;
+  //  3. up to 64 redistancing iterations from there (stopping early below 1e-6 voxel^2) bring
+  //     the field near the interface to the second-order fixed point the long run reached; the
+  //     band keeps its subcell values throughout (no re-initialisation).
+  // Near the grid's faces the long run was not a distance: with no inflow there its steady
+  // state kept the start field's small values at the faces and a unit slope from them, as if
+  // the faces were surfaces. The sweep measures the distance to the real surface there.
   Field3D scratch("sdf-scratch", g, p, ledger);
-  redistance(phi, r, scratch);
+  const int64_t band = exec::reduce("level set: interface", int64_t(phi.size()), int64_t(0),
+                                    InterfaceCount{FieldView(phi)}, Plus{});
+  if (band == 0) return phi;  // no interface: nothing to measure distance from
+  checkOrder(s);
+  redistancePass(phi, scratch, true, s.spatialOrder);
+  {
+    const size_t n = phi.size();
+    std::vector<float> dist(n);
+    std::vector<uint8_t> fixed(n);
+    std::vector<uint8_t> negative(n);
+    const FieldView start(phi), banded(scratch);
+    const InterfaceCount isBand{start};
+    for (size_t v = 0; v < n; ++v) {
+      negative[v] = start.load(v) < 0.f;
+      fixed[v] = isBand(int64_t(v)) != 0;
+      dist[v] = fixed[v] ? std::fabs(banded.load(v)) : std::numeric_limits<float>::infinity();
+    }
+    fastSweep(dist, fixed, g.dims, g.spacing, 1e-3f * g.minSpacing(), 8);
+    const FieldView out(phi);
+    for (size_t v = 0; v < n; ++v) {
+      const float d = std::min(dist[v], far);
+      out.store(v, negative[v] ? -d : d);
+    }
+  }
+  // 64 polishing iterations bring the worst error on a sphere from 0.9 voxel (the sweep's
+  // first order) to 0.26, as low as the full run's, and the band's from 0.13 to 0.03.
+  LevelSetSettings r = s;
+  r.redistanceIterations = std::max(s.redistanceIterations, 64);
+  r.redistanceTolerance = std::min(s.redistanceTolerance, 1e-6f);
+  Field3D* from = &phi;
+  Field3D* to = &scratch;
+  for (int it = 0; it < r.redistanceIterations; ++it) {
+    const double change = redistancePass(*from, *to, false, r.spatialOrder);
+    std::swap(from, to);
+    if (change < double(r.redistanceTolerance)) break;
+  }
+  if (from != &phi) copyField(*from, phi);
   return phi;
 }
 

@@ -10,5 +10,6 @@ BuiltinScene makeMarschnerLobb(int resolution, Precision precision, MemoryLedger
 BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeHydrogen(int resolution, Precision precision, MemoryLedger* ledger);
+BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger* ledger);
 
 }  // namespace visopt::scenes

@@ -28,6 +28,9 @@ const Entry kScenes[] = {
      &scenes::makeMixer},
     {"hydrogen", "Hydrogen 3d_z2 orbital density: lobes marked important, torus as context",
      &scenes::makeHydrogen},
+    {"occluded-blob",
+     "Paper 000 Fig. 3: a dense wall hides an optically thin important disc behind it",
+     &scenes::makeOccludedBlob},
 };
 
 }  // namespace

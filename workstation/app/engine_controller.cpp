@@ -1,0 +1,419 @@
+#include "engine_controller.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <future>
+
+#include <QMetaObject>
+#include <QPointer>
+
+#include <visopt/error.h>
+
+namespace visopt::ws {
+
+namespace {
+
+QImage toQImage(const Image& image) {
+  QImage out(image.width, image.height, QImage::Format_RGBA8888);
+  const auto rgba = image.toSrgb8();
+  for (int y = 0; y < image.height; ++y)
+    std::memcpy(out.scanLine(y), rgba.data() + size_t(y) * size_t(image.width) * 4,
+                size_t(image.width) * 4);
+  return out;
+}
+
+// Frames during optimisation: at most this often, so most of the time goes to iterating.
+constexpr int kFrameIntervalMs = 400;
+// Continuous optimisation stops iterating (until something changes) once the relative energy
+// change stayed below the level tolerance for this many iterations.
+constexpr int kConvergedIterations = 5;
+// Longest side of the image the optimisation's frustum grids are sized for while following the
+// camera: 128 view rays per side (frustumScale 0.5), about one per voxel column of a 128^3 scene.
+constexpr int kOptimizationSide = 256;
+
+}  // namespace
+
+EngineController::EngineController(Precision precision, QObject* parent)
+    : QObject(parent), precision_(precision) {
+  qRegisterMetaType<FrameInfo>();
+  qRegisterMetaType<IterationStats>();
+  sinceFrame_.start();
+  worker_ = std::thread([this] { workerLoop(); });
+}
+
+EngineController::~EngineController() {
+  {
+    std::lock_guard lock(mutex_);
+    quit_ = true;
+    cancel_ = true;
+  }
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void EngineController::deliver(std::function<void()> onUiThread) {
+  QMetaObject::invokeMethod(this, std::move(onUiThread), Qt::QueuedConnection);
+}
+
+void EngineController::post(const QString& what, Command command) {
+  {
+    std::lock_guard lock(mutex_);
+    tasks_.push_back(
+        {what, [c = std::move(command)](Engine& e, const ProgressCallback&) { c(e); }, false});
+  }
+  wake_.notify_all();
+}
+
+void EngineController::postLong(const QString& what, LongCommand command) {
+  {
+    std::lock_guard lock(mutex_);
+    tasks_.push_back({what, std::move(command), true});
+  }
+  wake_.notify_all();
+}
+
+void EngineController::call(const Command& command) {
+  auto done = std::make_shared<std::promise<void>>();
+  auto result = done->get_future();
+  {
+    std::lock_guard lock(mutex_);
+    tasks_.push_back({QStringLiteral("call"),
+                      [command, done](Engine& e, const ProgressCallback&) {
+                        try {
+                          command(e);
+                          done->set_value();
+                        } catch (...) {
+                          done->set_exception(std::current_exception());
+                        }
+                      },
+                      false});
+  }
+  wake_.notify_all();
+  result.get();
+}
+
+std::shared_ptr<const SceneSnapshot> EngineController::snapshot() const {
+  std::lock_guard lock(mutex_);
+  return snapshot_;
+}
+
+void EngineController::refreshSnapshot(Engine& engine, bool volumeChanged) {
+  auto snap = std::make_shared<SceneSnapshot>();
+  const auto previous = snapshot();
+  if (engine.hasVolume()) {
+    const Volume& v = engine.volume();
+    if (!volumeChanged && previous && previous->volume && previous->volume->grid() == v.grid()) {
+      snap->volume = previous->volume;  // same data: no copy, and the histogram stays cached
+    } else {
+      auto copy = std::make_shared<Volume>();
+      copy->name = v.name;
+      copy->sourcePath = v.sourcePath;
+      copy->scalarType = v.scalarType;
+      copy->valueMin = v.valueMin;
+      copy->valueMax = v.valueMax;
+      copy->normalized = cloneField(v.normalized);
+      snap->volume = std::move(copy);
+    }
+    snap->transferFunction = engine.transferFunction();
+    snap->surfaces = engine.contextSurfaces();
+    for (size_t i = 0; i < snap->surfaces.size(); ++i) {
+      const Field3D* base = engine.contextSurfaceBase(int(i));
+      snap->surfaceBases.push_back(base ? std::make_shared<const Field3D>(cloneField(*base))
+                                        : nullptr);
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    snapshot_ = std::move(snap);
+  }
+  deliver([this] { emit sceneChanged(); });
+}
+
+uint64_t EngineController::setCamera(const Camera& camera, bool interacting) {
+  uint64_t serial;
+  {
+    std::lock_guard lock(mutex_);
+    camera_ = camera;
+    serial = ++cameraSerial_;
+    cameraDirty_ = true;
+    interacting_ = interacting;
+    converged_ = false;
+  }
+  wake_.notify_all();
+  return serial;
+}
+
+Camera EngineController::camera() const {
+  std::lock_guard lock(mutex_);
+  return camera_;
+}
+
+void EngineController::setRenderSettings(const RenderSettings& settings) {
+  {
+    std::lock_guard lock(mutex_);
+    render_ = settings;
+    frameOwed_ = true;
+  }
+  wake_.notify_all();
+}
+
+RenderSettings EngineController::renderSettings() const {
+  std::lock_guard lock(mutex_);
+  return render_;
+}
+
+void EngineController::setViewportSize(int width, int height) {
+  {
+    std::lock_guard lock(mutex_);
+    if (width == viewportWidth_ && height == viewportHeight_) return;
+    viewportWidth_ = std::max(16, width);
+    viewportHeight_ = std::max(16, height);
+    frameOwed_ = true;
+  }
+  wake_.notify_all();
+}
+
+void EngineController::requestFrame() {
+  {
+    std::lock_guard lock(mutex_);
+    frameOwed_ = true;
+  }
+  wake_.notify_all();
+}
+
+void EngineController::setOptimizationRunning(bool running) {
+  running_ = running;
+  converged_ = false;
+  wake_.notify_all();
+}
+
+void EngineController::restartOptimization() {
+  {
+    std::lock_guard lock(mutex_);
+    restartPending_ = true;
+    converged_ = false;
+  }
+  wake_.notify_all();
+}
+
+bool EngineController::waitIdle(int timeoutMs) {
+  std::unique_lock lock(mutex_);
+  return idle_.wait_for(lock, std::chrono::milliseconds(timeoutMs),
+                        [this] { return !busy_ && !hasWorkLocked(); });
+}
+
+bool EngineController::hasWorkLocked() const {
+  const bool optimizing =
+      running_ && !converged_ && !interacting_ && snapshot_ && snapshot_->volume;
+  return !tasks_.empty() || cameraDirty_ || frameOwed_ || (previewShown_ && !interacting_) ||
+         optimizing;
+}
+
+void EngineController::runTask(Engine& engine, Task& task) {
+  cancel_ = false;
+  if (task.isLong) {
+    const QString what = task.what;
+    deliver([this, what] { emit longWorkStarted(what); });
+  }
+  ProgressCallback progress = [this](float fraction, const std::string& stage) {
+    const QString s = QString::fromStdString(stage);
+    deliver([this, s, fraction] { emit progressChanged(s, double(fraction)); });
+    return !cancel_.load();
+  };
+  bool ok = true;
+  try {
+    task.command(engine, progress);
+  } catch (const Error& e) {
+    ok = false;
+    if (e.kind() != ErrorKind::Cancelled) {
+      const QString msg = task.what + QStringLiteral(": ") + QString::fromUtf8(e.what());
+      deliver([this, msg] { emit errorOccurred(msg); });
+    }
+  } catch (const std::exception& e) {
+    ok = false;
+    const QString msg = task.what + QStringLiteral(": ") + QString::fromUtf8(e.what());
+    deliver([this, msg] { emit errorOccurred(msg); });
+  }
+  if (task.isLong) deliver([this, ok] { emit longWorkFinished(ok); });
+  followIterations_ = 0;
+  std::lock_guard lock(mutex_);
+  frameOwed_ = true;
+  converged_ = false;
+}
+
+void EngineController::renderFrame(Engine& engine, bool preview) {
+  RenderSettings settings;
+  FrameInfo info;
+  {
+    std::lock_guard lock(mutex_);
+    settings = render_;
+    settings.width = viewportWidth_;
+    settings.height = viewportHeight_;
+    info.cameraSerial = renderedSerial_;
+    info.camera = camera_;
+  }
+  settings.preview = preview;
+  info.preview = preview;
+  RenderStats stats;
+  QImage image;
+  try {
+    image = toQImage(engine.render(settings, &stats));
+  } catch (const std::exception& e) {
+    const QString msg = QStringLiteral("render: ") + QString::fromUtf8(e.what());
+    deliver([this, msg] { emit errorOccurred(msg); });
+    return;
+  }
+  info.renderMs = stats.milliseconds;
+  {
+    std::lock_guard lock(mutex_);
+    previewShown_ = preview;
+    if (!preview) frameOwed_ = false;
+  }
+  sinceFrame_.restart();
+  itersSinceFrame_ = 0;
+  deliver([this, image, info] { emit frameReady(image, info); });
+}
+
+void EngineController::optimizeStep(Engine& engine) {
+  const auto interrupt = [this] {
+    std::lock_guard lock(mutex_);
+    return quit_ || !tasks_.empty() || cameraDirty_ || !running_;
+  };
+  const auto report = [this, &engine](const IterationStats& st) {
+    const qulonglong bytes = engine.ledger().totalBytes();
+    deliver([this, st, bytes] { emit iterationDone(st, bytes); });
+  };
+  bool restart;
+  {
+    std::lock_guard lock(mutex_);
+    restart = restartPending_;
+    restartPending_ = false;
+  }
+  const auto settle = [this] {
+    quietIterations_ = followIterations_ = 0;
+    converged_ = true;
+    deliver([this] { emit convergedChanged(true); });
+  };
+  if (restart) {
+    engine.resetOptimization();
+    bool interrupted = false;
+    engine.optimize([&](const IterationStats& st) {
+      report(st);
+      if (sinceFrame_.elapsed() > kFrameIntervalMs) renderFrame(engine, false);
+      interrupted = interrupt();
+      return !interrupted;
+    });
+    // The coarse-to-fine schedule ran to its end (each level to its tolerance or cap).
+    if (!interrupted) settle();
+    std::lock_guard lock(mutex_);
+    frameOwed_ = true;
+    return;
+  }
+  const auto stats = engine.continueOptimization(1);
+  if (stats.empty()) {  // frozen
+    converged_ = true;
+    return;
+  }
+  report(stats.back());
+  const double e = stats.back().energy();
+  const double rel = std::abs(e - lastEnergy_) / std::max(std::abs(e), 1e-30);
+  lastEnergy_ = e;
+  quietIterations_ = rel < engine.extinctionSettings().tolerance ? quietIterations_ + 1 : 0;
+  // Following the camera: stop when the energy is still, or after a level's iteration budget.
+  if (quietIterations_ >= kConvergedIterations ||
+      ++followIterations_ >= engine.extinctionSettings().maxIterationsPerLevel)
+    settle();
+  std::lock_guard lock(mutex_);
+  frameOwed_ = true;
+}
+
+void EngineController::workerLoop() {
+  Engine engine(precision_);
+  for (;;) {
+    Task task;
+    bool haveTask = false;
+    {
+      std::unique_lock lock(mutex_);
+      if (!hasWorkLocked()) {
+        busy_ = false;
+        idle_.notify_all();
+      }
+      wake_.wait(lock, [this] { return quit_ || hasWorkLocked(); });
+      if (quit_) break;
+      busy_ = true;
+      if (!tasks_.empty()) {
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+        haveTask = true;
+      }
+    }
+    if (haveTask) {
+      runTask(engine, task);
+      continue;
+    }
+
+    bool cameraChanged = false, interacting = false;
+    Camera cam;
+    int w, h;
+    {
+      std::lock_guard lock(mutex_);
+      if (cameraDirty_) {
+        cam = camera_;
+        renderedSerial_ = cameraSerial_;
+        cameraDirty_ = false;
+        cameraChanged = true;
+      }
+      interacting = interacting_;
+      w = viewportWidth_;
+      h = viewportHeight_;
+    }
+    if (!engine.hasVolume()) {
+      std::lock_guard lock(mutex_);
+      frameOwed_ = previewShown_ = false;
+      continue;
+    }
+    if (cameraChanged) followIterations_ = 0;
+    try {
+      if (cameraChanged) engine.setCamera(cam);
+      // The frustum grids follow the image's shape, not its pixel count: a large window would
+      // otherwise make every iteration (and so the camera's response) slower.
+      const float shrink = std::min(1.f, float(kOptimizationSide) / float(std::max(w, h)));
+      engine.setViewportSize(std::max(16, int(float(w) * shrink)),
+                             std::max(16, int(float(h) * shrink)));
+    } catch (const std::exception&) {
+    }
+    if (cameraChanged && interacting) {
+      renderFrame(engine, true);  // the preview first: it is what the user waits for
+      continue;
+    }
+    if (cameraChanged) {
+      renderFrame(engine, false);
+      continue;
+    }
+    // While the user drags, only previews: an iteration in flight is all the camera waits for.
+    const bool optimizing = running_ && !converged_ && !interacting && engine.hasImportance();
+    if (optimizing) {
+      try {
+        optimizeStep(engine);
+      } catch (const std::exception& e) {
+        running_ = false;
+        const QString msg = QStringLiteral("optimisation: ") + QString::fromUtf8(e.what());
+        deliver([this, msg] { emit errorOccurred(msg); });
+      }
+      if (sinceFrame_.elapsed() > kFrameIntervalMs || converged_) renderFrame(engine, interacting);
+      continue;
+    }
+    if (running_ && !engine.hasImportance()) converged_ = true;
+    bool owed, previewShown;
+    {
+      std::lock_guard lock(mutex_);
+      owed = frameOwed_;
+      previewShown = previewShown_;
+    }
+    if (owed || (previewShown && !interacting)) renderFrame(engine, interacting);
+  }
+}
+
+}  // namespace visopt::ws

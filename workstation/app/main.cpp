@@ -1,0 +1,150 @@
+// visopt-workstation: the Qt application. Without arguments it opens the built-in default scene
+// (or offers to recover a crashed session). Scripting options open a scene, a volume or a
+// session, export a screenshot after the first converged frame and quit, or measure the latency
+// from a camera drag to the preview on screen while the optimisation runs.
+#include <cstdio>
+
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QElapsedTimer>
+#include <QTimer>
+
+#include <visopt/scenes.h>
+
+#include "camera_navigation.h"
+#include "main_window.h"
+#include "viewport_widget.h"
+
+using namespace visopt;
+using namespace visopt::ws;
+
+namespace {
+
+// Drags the camera while the optimisation runs and reports the time from each camera change to
+// the frame that shows it. Each drag is a press, a small orbit and a release, followed by a
+// pause in which the optimisation resumes, so every drag meets an iteration in flight.
+int runLatencyProbe(MainWindow& window, int steps) {
+  ViewportWidget* view = window.viewport();
+  const auto pump = [](int ms) {
+    QElapsedTimer t;
+    t.start();
+    while (t.elapsed() < ms) QApplication::processEvents(QEventLoop::AllEvents, 5);
+  };
+  for (int i = 0; i < steps; ++i) {
+    const int before = view->previewLatency().samples;
+    view->setCamera(orbitCamera(view->camera(), 3.f, 0.f), true);
+    QElapsedTimer t;
+    t.start();
+    while (view->previewLatency().samples == before && t.elapsed() < 30000)
+      QApplication::processEvents(QEventLoop::AllEvents, 1);
+    view->setCamera(view->camera(), false);
+    pump(1500);  // the optimisation follows the new view meanwhile
+  }
+  window.waitForSettledFrame(60000);
+  const LatencyStats s = view->previewLatency();
+  std::printf(
+      "{\"latencyProbe\": {\"drags\": %d, \"framesMatched\": %d, \"meanMs\": %.1f, "
+      "\"p95Ms\": %.1f, \"maxMs\": %.1f}}\n",
+      steps, s.samples, s.meanMs, s.p95Ms, s.maxMs);
+  return s.samples > 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  QApplication app(argc, argv);
+  QApplication::setApplicationName(QStringLiteral("visopt"));
+  QApplication::setOrganizationName(QStringLiteral("visopt"));
+
+  QCommandLineParser parser;
+  parser.setApplicationDescription(
+      QStringLiteral("visopt workstation: see what matters inside a volume"));
+  parser.addHelpOption();
+  QCommandLineOption scene(QStringLiteral("scene"), QStringLiteral("Open builtin:NAME."),
+                           QStringLiteral("builtin:NAME"));
+  QCommandLineOption volume(QStringLiteral("volume"),
+                            QStringLiteral("Open a volume file or DICOM folder."),
+                            QStringLiteral("FILE"));
+  QCommandLineOption session(QStringLiteral("session"), QStringLiteral("Open a session."),
+                             QStringLiteral("FILE"));
+  QCommandLineOption resolution(QStringLiteral("resolution"),
+                                QStringLiteral("Built-in scene resolution (default 128)."),
+                                QStringLiteral("N"), QStringLiteral("128"));
+  QCommandLineOption screenshot(
+      QStringLiteral("screenshot"),
+      QStringLiteral("Save the viewport after the first converged frame and quit."),
+      QStringLiteral("PNG"));
+  QCommandLineOption windowShot(
+      QStringLiteral("window-screenshot"),
+      QStringLiteral("Save the whole window after the first converged frame and quit."),
+      QStringLiteral("PNG"));
+  QCommandLineOption size(QStringLiteral("size"), QStringLiteral("Window size WxH."),
+                          QStringLiteral("WxH"));
+  QCommandLineOption noOptimize(QStringLiteral("no-optimize"),
+                                QStringLiteral("Start with the optimisation paused."));
+  QCommandLineOption latency(QStringLiteral("latency-probe"),
+                             QStringLiteral("Drag the camera N times while optimising, print "
+                                            "the drag-to-preview latency as JSON and quit."),
+                             QStringLiteral("N"));
+  QCommandLineOption stateDir(QStringLiteral("state-dir"),
+                              QStringLiteral("Folder for autosave and recent sessions."),
+                              QStringLiteral("DIR"));
+  QCommandLineOption timeout(QStringLiteral("timeout"),
+                             QStringLiteral("Seconds to wait for convergence (default 300)."),
+                             QStringLiteral("S"), QStringLiteral("300"));
+  QCommandLineOption saveTo(QStringLiteral("save-session"),
+                            QStringLiteral("Save the session after the first converged frame "
+                                           "and quit."),
+                            QStringLiteral("FILE"));
+  parser.addOptions({scene, volume, session, resolution, screenshot, windowShot, size, noOptimize,
+                     latency, stateDir, timeout, saveTo});
+  parser.process(app);
+
+  const bool scripted = parser.isSet(screenshot) || parser.isSet(windowShot) ||
+                        parser.isSet(latency) || parser.isSet(saveTo);
+  MainWindow window(Precision::FP32, parser.value(stateDir));
+  window.setInteractive(!scripted);
+  if (parser.isSet(size)) {
+    const QStringList wh = parser.value(size).split('x');
+    if (wh.size() == 2) window.resize(wh[0].toInt(), wh[1].toInt());
+  }
+  window.show();
+  window.setOptimizationRunning(!parser.isSet(noOptimize));
+
+  int failures = 0;
+  QObject::connect(&window, &MainWindow::errorShown, [&](const QString& message) {
+    std::fprintf(stderr, "visopt-workstation: %s\n", message.toUtf8().constData());
+    ++failures;
+  });
+
+  const bool recovered = !scripted && !parser.isSet(session) && window.offerRecovery();
+  if (parser.isSet(session)) {
+    if (!window.openSession(parser.value(session)) && scripted) return 1;
+  } else if (parser.isSet(volume)) {
+    window.openVolume(parser.value(volume));
+  } else if (!recovered) {
+    QString name = parser.value(scene);
+    if (name.startsWith(QStringLiteral("builtin:"))) name = name.mid(8);
+    if (name.isEmpty()) name = QString::fromStdString(defaultSceneName());
+    window.openBuiltinScene(name, parser.value(resolution).toInt());
+  }
+
+  if (!scripted) return app.exec();
+
+  const int timeoutMs = parser.value(timeout).toInt() * 1000;
+  if (!window.waitForSettledFrame(timeoutMs)) {
+    std::fprintf(stderr, "visopt-workstation: no converged frame within %d s\n", timeoutMs / 1000);
+    return 1;
+  }
+  if (failures > 0) return 1;
+  int rc = 0;
+  if (parser.isSet(latency)) rc = runLatencyProbe(window, parser.value(latency).toInt());
+  if (parser.isSet(screenshot) && !window.exportViewport(parser.value(screenshot))) rc = 1;
+  if (parser.isSet(windowShot)) {
+    QApplication::processEvents();
+    if (!window.grab().save(parser.value(windowShot), "PNG")) rc = 1;
+  }
+  if (parser.isSet(saveTo) && !window.saveSessionTo(parser.value(saveTo))) rc = 1;
+  window.close();
+  return rc;
+}

@@ -13,6 +13,8 @@
 
 #include "core/device_bit_mask.h"
 #include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "kernels/surface_shading.h"
 #include "optimize/level_set.h"
 #include "visopt/error.h"
 #include "visopt/field.h"
@@ -237,6 +239,40 @@ TEST_P(LevelSet, RedistancingAnExactSdfChangesLittle) {
   EXPECT_EQ(grad.outside, 0) << grad.min << " .. " << grad.max;
 }
 
+// The grid's faces let nothing in: a start field that is far too small at one face (as an
+// unconverged field or a field cut by the grid is) becomes the distance to the sphere there,
+// rather than a surface of its own that the interior measures its distance from.
+TEST_P(LevelSet, RedistancingFollowsTheInteriorAtTheFaces) {
+  const GridSpec g = cube(32);
+  const glm::vec3 centre(16.2f, 15.8f, 16.1f);
+  const float radius = 6.f;
+  const Fn exact = sphere(centre, radius);
+  Field3D phi = makeField("phi", g, GetParam(), [&](glm::vec3 x) {
+    return x.x < 0.5f ? 1.f : exact(x);  // the x = 0 face at 1 voxel, the distance ~10
+  });
+  Field3D scratch;
+  LevelSetSettings s;
+  s.redistanceIterations = 300;
+  s.redistanceTolerance = 1e-7f;
+  redistance(phi, s, scratch);
+  float worstFace = 0.f, worst = 0.f;
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = 0; j < g.dims.y; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const size_t v = g.linearIndex(i, j, k);
+        const float err = std::fabs(phi.get(v) - exact(g.indexToWorld(glm::vec3(i, j, k))));
+        worst = std::max(worst, err);
+        if (i == 0) worstFace = std::max(worstFace, err);
+      }
+  std::printf(
+      "redistance at the faces (%s): worst error on the x = 0 face %.3f voxel, "
+      "anywhere %.3f\n",
+      toString(GetParam()), worstFace, worst);
+  EXPECT_LT(worstFace, 0.6f);
+  EXPECT_LT(worst, 0.6f);
+  EXPECT_LT(zeroSetDrift(phi, centre, radius), 0.1f);
+}
+
 // ---- an SDF from an isovalue; thin shells -------------------------------------------------
 
 // s = exp(-r^2 / (2 sigma^2)) in data units [100, 1100], isosurface at r = R: a sphere SDF
@@ -274,6 +310,84 @@ TEST_P(LevelSet, SdfFromIsovalueOfAGaussianIsASphere) {
   // insideHigh = false flips the sign.
   Field3D outside = sdfFromIsovalue(volume, iso, false, s, GetParam(), nullptr);
   for (size_t v = 0; v < phi.size(); v += 97) EXPECT_NEAR(outside.get(v), -phi.get(v), 1e-3f);
+}
+
+// Shading normals (kernels/surface_shading.h's surfaceNormal) of the SDF of a sampled sphere
+// whose edge is as sharp as the grid: a ball with a 2-voxel smoothstep edge, a 2-voxel wall
+// (the Shepp-Logan skull), a piecewise-constant ball. The trilinear zero set of such a field is
+// terraced, which showed as fingerprint rings in the highlights; sdfFromIsovalue's Gaussian
+// pre-smoothing and the normal taken outside the surface keep the angle to the exact normal
+// small. Measured mean / max (deg) without the smoothing and with the normal centred on the
+// surface: ball 3.3 / 11.6, wall 6.7 / 17.9; with both: 1.5 / 10.4 and 1.4 / 9.5.
+struct NormalError {
+  double mean = 0.0, max = 0.0, drift = 0.0;  // degrees, degrees, voxels
+};
+NormalError shadingNormalError(const Fn& density, glm::vec3 centre, float radius, float sigma) {
+  const GridSpec g = cube(64);
+  Volume volume;
+  volume.valueMin = 0.0;
+  volume.valueMax = 1.0;
+  volume.normalized = makeField("s", g, Precision::FP32, density);
+  const Field3D phi =
+      sdfFromIsovalue(volume, 0.5, true, LevelSetSettings{}, Precision::FP32, nullptr, sigma);
+  const FieldView view(phi);
+  const GridMap map(g);
+  NormalError e;
+  int n = 0;
+  for (glm::vec3 d : directions(2000)) {
+    // The zero crossing along the ray from the centre, by bisection (outside the wall's
+    // inner face).
+    float a = radius - 1.f, b = radius + 3.f;
+    const auto at = [&](float r) { return view.sample(g.worldToIndex(centre + r * d)); };
+    if (!(at(a) < 0.f && at(b) > 0.f)) continue;
+    for (int it = 0; it < 40; ++it) (at(0.5f * (a + b)) < 0.f ? a : b) = 0.5f * (a + b);
+    const float r = 0.5f * (a + b);
+    const glm::vec3 normal = surfaceNormal(view, g.worldToIndex(centre + r * d), map);
+    const double angle =
+        std::acos(std::clamp(double(glm::dot(normal, d)), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+    e.mean += angle;
+    e.max = std::max(e.max, angle);
+    e.drift = std::max(e.drift, double(std::fabs(r - radius)));
+    ++n;
+  }
+  EXPECT_EQ(n, 2000);
+  e.mean /= std::max(n, 1);
+  return e;
+}
+
+float smoothStep(float e0, float e1, float x) {
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.f, 1.f);
+  return t * t * (3.f - 2.f * t);
+}
+
+TEST(LevelSetShading, NormalsOfSharpEdgedPhantomsStayClose) {
+  const glm::vec3 c(31.7f, 32.2f, 31.9f);
+  const float R = 22.3f;
+  const Fn ball = [=](glm::vec3 x) { return 1.f - smoothStep(-1.f, 1.f, glm::length(x - c) - R); };
+  const Fn wall = [=](glm::vec3 x) {
+    const float r = glm::length(x - c);
+    return (1.f - smoothStep(-1.f, 1.f, r - R)) -
+           0.98f * (1.f - smoothStep(-1.f, 1.f, r - (R - 2.f)));
+  };
+  const Fn hard = [=](glm::vec3 x) { return glm::length(x - c) < R ? 1.f : 0.f; };
+  struct Case {
+    const char* name;
+    Fn f;
+    double meanBound, maxBound, driftBound;
+  };
+  for (const Case& k :
+       {Case{"soft ball", ball, 2.2, 12.0, 0.3}, Case{"2-voxel wall", wall, 2.2, 12.0, 0.3},
+        Case{"hard ball", hard, 3.5, 12.0, 0.55}}) {
+    const NormalError raw = shadingNormalError(k.f, c, R, 0.f);
+    const NormalError e = shadingNormalError(k.f, c, R, kIsoPresmoothSigma);
+    std::printf(
+        "shading normals, %s: mean %.2f max %.2f deg, zero set within %.3f voxel "
+        "(unsmoothed: %.2f / %.2f deg, %.3f voxel)\n",
+        k.name, e.mean, e.max, e.drift, raw.mean, raw.max, raw.drift);
+    EXPECT_LT(e.mean, k.meanBound) << k.name;
+    EXPECT_LT(e.max, k.maxBound) << k.name;
+    EXPECT_LT(e.drift, k.driftBound) << k.name;
+  }
 }
 
 TEST_P(LevelSet, ThinShellValues) {

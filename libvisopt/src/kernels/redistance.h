@@ -15,6 +15,8 @@
 // and it keeps that value through the iterations (Russo & Smereka relax towards the same D;
 // holding it fixed is their steady state). Every other voxel is upwinded from that band.
 //
+// At the grid's faces nothing flows in (inflowOnly below): a face voxel follows the interior.
+//
 // S: its sign is the start field's sign. A voxel away from the interface never changes sign
 // (each update is limited to at most halving |phi|, and upwinding only reads same-signed
 // neighbours), so the sign of the current value is the start sign; its magnitude uses the
@@ -37,6 +39,19 @@ VISOPT_HD VISOPT_INLINE bool nextToInterface(float c, float xm, float xp, float 
                                              float zm, float zp) {
   return c * xm <= 0.f || c * xp <= 0.f || c * ym <= 0.f || c * yp <= 0.f || c * zm <= 0.f ||
          c * zp <= 0.f;
+}
+
+// The grid's faces let nothing in: the one-sided difference reaching past a face is 0, so
+// Godunov's |grad phi| there upwinds from the interior only. With the extrapolation of
+// level_set_step.h (the missing difference copies the other) a face voxel is its own upwind
+// neighbour, so any value it starts with is a steady state and the interior takes a unit slope
+// from it, as if the face were a surface (a face voxel stayed at 1.08 voxels where the
+// distance was 16.9). Without inflow, a face value too small (|grad phi| < 1 seen from the
+// interior) grows until it is one voxel's distance beyond its neighbour's.
+VISOPT_HD VISOPT_INLINE OneSided inflowOnly(OneSided d, const StencilAxis& a) {
+  if (a.lo) d.dm = 0.f;
+  if (a.hi) d.dp = 0.f;
+  return d;
 }
 
 template <class A, int Order>
@@ -80,9 +95,9 @@ struct RedistanceKernel {
     // Sussman's update elsewhere.
     const float sgn = c / sqrtf(c * c + dxMin * dxMin);
     const bool positive = sgn > 0.f;
-    const OneSided dx = upwindDifferences<A, Order>(in, s, xm, c, xp, ax);
-    const OneSided dy = upwindDifferences<A, Order>(in, s, ym, c, yp, ay);
-    const OneSided dz = upwindDifferences<A, Order>(in, s, zm, c, zp, az);
+    const OneSided dx = inflowOnly(upwindDifferences<A, Order>(in, s, xm, c, xp, ax), ax);
+    const OneSided dy = inflowOnly(upwindDifferences<A, Order>(in, s, ym, c, yp, ay), ay);
+    const OneSided dz = inflowOnly(upwindDifferences<A, Order>(in, s, zm, c, zp, az), az);
     const float grad = sqrtf(godunovSquared(dx, positive) + godunovSquared(dy, positive) +
                              godunovSquared(dz, positive));
     const float moved = c - dtau * sgn * (grad - 1.f);

@@ -347,17 +347,61 @@ void fastSweep(std::vector<float>& d, const std::vector<uint8_t>& fixed, glm::iv
   }
 }
 
+// A separable Gaussian of standard deviation sigma (voxels of each axis) of `in`, in fp32; the
+// edge voxels repeat beyond the faces. Host code, once per base SDF.
+Field3D gaussianSmoothed(const Field3D& in, float sigma, MemoryLedger* ledger) {
+  const GridSpec& g = in.grid();
+  const int64_t n[3] = {g.dims.x, g.dims.y, g.dims.z};
+  const int64_t stride[3] = {1, n[0], n[0] * n[1]};
+  const int radius = std::max(1, int(std::ceil(3.f * sigma)));
+  std::vector<float> w(static_cast<size_t>(2 * radius + 1));
+  float total = 0.f;
+  for (int o = -radius; o <= radius; ++o)
+    total += w[size_t(o + radius)] = std::exp(-0.5f * float(o * o) / (sigma * sigma));
+  for (float& x : w) x /= total;
+  const FieldView src(in);
+  std::vector<float> a(in.size()), b(in.size());
+  for (size_t v = 0; v < a.size(); ++v) a[v] = src.load(v);
+  for (int axis = 0; axis < 3; ++axis) {
+    const int64_t len = n[axis], st = stride[axis];
+    if (len < 2) continue;
+    std::vector<float> line(static_cast<size_t>(len));
+    for (int64_t start = 0; start < int64_t(a.size()); ++start) {
+      if ((start / st) % len != 0) continue;  // one line per voxel on the axis's first plane
+      for (int64_t q = 0; q < len; ++q) line[size_t(q)] = a[size_t(start + q * st)];
+      for (int64_t q = 0; q < len; ++q) {
+        float acc = 0.f;
+        for (int o = -radius; o <= radius; ++o)
+          acc += w[size_t(o + radius)] * line[size_t(std::clamp<int64_t>(q + o, 0, len - 1))];
+        b[size_t(start + q * st)] = acc;
+      }
+    }
+    std::swap(a, b);
+  }
+  Field3D out("sdf-smoothed-scalar", g, Precision::FP32, ledger);
+  const FieldView dst(out);
+  for (size_t v = 0; v < a.size(); ++v) dst.store(v, a[v]);
+  return out;
+}
+
 }  // namespace
 
 Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
-                        const LevelSetSettings& s, Precision p, MemoryLedger* ledger) {
+                        const LevelSetSettings& s, Precision p, MemoryLedger* ledger,
+                        float presmoothSigma) {
   if (volume.normalized.empty())
     throw Error(ErrorKind::Usage, "SDF from an isovalue: the volume is empty");
   if (!std::isfinite(isovalue))
     throw Error(ErrorKind::Usage, "SDF from an isovalue: the isovalue is not a number");
+  if (std::isnan(presmoothSigma))
+    throw Error(ErrorKind::Usage, "SDF from an isovalue: the smoothing sigma is not a number");
   const GridSpec& g = volume.grid();
   const float iso = volume.toNormalized(isovalue);
-  IsoGradientKernel gk{FieldView(volume.normalized), iso, g.spacing, false};
+  // The isovalue is crossed in the pre-smoothed field (see the header for why and how much).
+  Field3D smoothed;
+  if (presmoothSigma > 0.f) smoothed = gaussianSmoothed(volume.normalized, presmoothSigma, ledger);
+  const Field3D& scalar = smoothed.empty() ? volume.normalized : smoothed;
+  IsoGradientKernel gk{FieldView(scalar), iso, g.spacing, false};
   IsoGradient grad =
       exec::reduce("sdf: iso gradient", int64_t(g.voxelCount()), IsoGradient{}, gk, Plus{});
   if (grad.count == 0 || grad.sum <= 0.0) {
@@ -370,12 +414,13 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
 
   Field3D phi("context-sdf", g, p, ledger);
   {
-    const FieldView src(volume.normalized), dst(phi);
+    const FieldView src(scalar), dst(phi);
     exec::parallelFor("sdf: from isovalue", int64_t(g.voxelCount()), [=] VISOPT_HD(int64_t v) {
       const float d = sign * (src.load(size_t(v)) - iso) * scale;
       dst.store(size_t(v), fminf(fmaxf(d, -far), far));
     });
   }
+  smoothed = Field3D();  // `scalar` is not read after this
   // The distance away from the interface by fast sweeping, then redistancing (Eq. 18) only to
   // polish. Redistancing alone from s - iso needs enough iterations for the front to cross the
   // grid (corrections travel half a voxel per iteration): 800 on a 256^2 x 108 CT. Here:
@@ -386,9 +431,8 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
   //  3. up to 64 redistancing iterations from there (stopping early below 1e-6 voxel^2) bring
   //     the field near the interface to the second-order fixed point the long run reached; the
   //     band keeps its subcell values throughout (no re-initialisation).
-  // Near the grid's faces the long run was not a distance: with no inflow there its steady
-  // state kept the start field's small values at the faces and a unit slope from them, as if
-  // the faces were surfaces. The sweep measures the distance to the real surface there.
+  // Near the grid's faces the sweep measures the distance to the real surface; redistancing
+  // lets nothing in through the faces (kernels/redistance.h), so the polish keeps it.
   Field3D scratch("sdf-scratch", g, p, ledger);
   const int64_t band = exec::reduce("level set: interface", int64_t(phi.size()), int64_t(0),
                                     InterfaceCount{FieldView(phi)}, Plus{});

@@ -41,13 +41,31 @@ double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& g
                        Field3D& out);
 double redistanceIteration(const Field3D& in, Field3D& out, int spatialOrder = 2);
 
-// phi(x, 0) = +-(s(x) - iso) / |grad s| (inside negative: with insideHigh, values above the
-// isovalue are inside), |grad s| the mean central-difference gradient magnitude over the voxels
+// The default Gaussian pre-smoothing of sdfFromIsovalue, sigma in voxels (see there).
+inline constexpr float kIsoPresmoothSigma = 0.85f;
+
+// phi(x, 0) = +-(s~(x) - iso) / |grad s~| (inside negative: with insideHigh, values above the
+// isovalue are inside), |grad s~| the mean central-difference gradient magnitude over the voxels
 // next to the isosurface, then redistanced until converged (at least enough iterations for
 // the front to cross the grid's diagonal). `isovalue` is in the volume's data units. A volume
 // that never crosses the isovalue gives the scaled difference, all of one sign.
+//
+// s~ is s smoothed by a separable Gaussian of standard deviation `presmoothSigma` voxels along
+// each axis (in that axis's own voxels; edge voxels repeat at the faces; <= 0: no smoothing).
+// Why: the zero set of the trilinear interpolant of a field whose edge is about as sharp as the
+// grid (a piecewise-constant phantom, a thin wall, bone or skin in CT) is terraced at voxel
+// scale, and the SDF inherits the terraces, so shaded normals ripple in rings and contour-line
+// dots ("fingerprints"). On a sphere phantom with a 2-voxel smoothstep edge the normal at the
+// zero set (central differences over +-0.5 voxel) is off by 2.4 deg mean / 8 deg max without
+// smoothing, 1.0 / 3.5 deg at sigma 0.85.
+// sigma 0.85 removes most of the aliasing (the Gaussian's response at the grid's Nyquist
+// frequency is exp(-pi^2 sigma^2 / 2) ~ 3 %) while moving the zero set of smooth data by
+// ~sigma^2 / (2 R) (0.035 voxel on a sphere of 22 voxels) and that of a 2-voxel wall by < 0.2
+// voxel. Larger sigmas erase thin walls: at 1.2 the built-in Shepp-Logan skull (a wall of 2-3
+// voxels at 128^3) already opens.
 Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
-                        const LevelSetSettings& s, Precision p, MemoryLedger* ledger);
+                        const LevelSetSettings& s, Precision p, MemoryLedger* ledger,
+                        float presmoothSigma = kIsoPresmoothSigma);
 
 // Eq. 26: |phi0| - d, d >= 0 in world units (BadInput/Usage error for d < 0 or NaN).
 // d = 0 is an infinitely thin shell: the field is >= 0 everywhere and touches 0 only on the

@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include <glm/glm.hpp>
 
@@ -47,15 +48,61 @@ struct Fp32Access {
   VISOPT_HD VISOPT_INLINE float kept(float v) const { return v; }  // what a store keeps
 };
 
+// fp16 to fp32 for the host row loops: g++ converts _Float16 one value at a time, which keeps
+// them scalar, so this widens the bits with integer ops and a multiply by 2^112 (exact for
+// normal and subnormal halves) and patches inf/NaN: the same value as halfToFloat, vectorised.
+// nvcc-compiled code keeps halfToFloat.
+VISOPT_HD VISOPT_INLINE float halfToFloatRow(Half h) {
+#if defined(__CUDACC__)
+  return halfToFloat(h);
+#else
+  const uint32_t bits = h.bits;
+  const uint32_t magnitude = (bits & 0x7fffu) << 13;
+  float f;
+  std::memcpy(&f, &magnitude, 4);
+  f *= 0x1p112f;
+  uint32_t u;
+  std::memcpy(&u, &f, 4);
+  u |= (bits & 0x7c00u) == 0x7c00u ? 0x7f800000u : 0u;
+  u |= (bits & 0x8000u) << 16;
+  std::memcpy(&f, &u, 4);
+  return f;
+#endif
+}
+
+// fp32 to fp16 for |v| <= 65504 (what Fp16Access stores after saturating), rounding to nearest
+// even in integer ops (and one add for subnormals) the compiler can vectorise: the same bits as
+// floatToHalf there. nvcc-compiled code keeps floatToHalf.
+VISOPT_HD VISOPT_INLINE Half floatToHalfRow(float v) {
+#if defined(__CUDACC__)
+  return floatToHalf(v);
+#else
+  uint32_t f;
+  std::memcpy(&f, &v, 4);
+  const uint32_t sign = f & 0x80000000u;
+  f ^= sign;
+  // Normal halves: rebias the exponent, round the 13 dropped bits to nearest even.
+  const uint32_t normal = (f + 0xc8000fffu + ((f >> 13) & 1u)) >> 13;
+  // Subnormal halves (below 2^-14): adding 0.5 lets the FPU round the mantissa into place.
+  float t;
+  std::memcpy(&t, &f, 4);
+  t += 0.5f;
+  uint32_t tb;
+  std::memcpy(&tb, &t, 4);
+  const uint32_t subnormal = tb - 0x3f000000u;
+  return Half{uint16_t((f < 0x38800000u ? subnormal : normal) | (sign >> 16))};
+#endif
+}
+
 struct Fp16Access {
   Half* p = nullptr;
-  VISOPT_HD VISOPT_INLINE float load(size_t i) const { return halfToFloat(p[i]); }
+  VISOPT_HD VISOPT_INLINE float load(size_t i) const { return halfToFloatRow(p[i]); }
   // Saturates at fp16's largest finite value, as FieldView::store does.
   VISOPT_HD VISOPT_INLINE void store(size_t i, float v) const {
-    p[i] = floatToHalf(minOf(maxOf(v, -65504.f), 65504.f));
+    p[i] = floatToHalfRow(minOf(maxOf(v, -65504.f), 65504.f));
   }
   VISOPT_HD VISOPT_INLINE float kept(float v) const {
-    return halfToFloat(floatToHalf(minOf(maxOf(v, -65504.f), 65504.f)));
+    return halfToFloatRow(floatToHalfRow(minOf(maxOf(v, -65504.f), 65504.f)));
   }
 };
 
@@ -99,11 +146,31 @@ VISOPT_HD VISOPT_INLINE StencilAxis stencilAxis(int idx, int n, int64_t stride, 
   return a;
 }
 
+// The same for a voxel at least two voxels from both borders of an axis of at least 5: the
+// border flags are compile-time false, so the interior loops carry no border selects.
+struct InnerAxis {
+  int64_t m = 0, p = 0, mm = 0, pp = 0;
+  float inv = 0.f, central = 0.f;
+  static constexpr bool lo = false, hi = false, lo2 = false, hi2 = false;
+};
+
+VISOPT_HD VISOPT_INLINE InnerAxis innerAxis(int64_t stride, float h) {
+  InnerAxis a;
+  a.m = -stride;
+  a.p = stride;
+  a.mm = -2 * stride;
+  a.pp = 2 * stride;
+  a.inv = 1.f / h;
+  a.central = 0.5f * a.inv;
+  return a;
+}
+
 // One-sided differences D-, D+ with the border extrapolation described above.
 struct OneSided {
   float dm, dp;
 };
-VISOPT_HD VISOPT_INLINE OneSided oneSided(float m, float c, float p, const StencilAxis& a) {
+template <class Ax>
+VISOPT_HD VISOPT_INLINE OneSided oneSided(float m, float c, float p, const Ax& a) {
   float dm = (c - m) * a.inv, dp = (p - c) * a.inv;
   if (a.lo) dm = dp;
   if (a.hi) dp = dm;
@@ -118,8 +185,9 @@ VISOPT_HD VISOPT_INLINE float minmod(float a, float b) {
 // the smaller (minmod) of the two adjacent second differences. Second differences that would
 // need a value beyond the border are 0 (linear extrapolation), so borders fall back to first
 // order, and so do kinks, where the two second differences disagree in sign.
+template <class Ax>
 VISOPT_HD VISOPT_INLINE OneSided oneSidedEno2(float mm, float m, float c, float p, float pp,
-                                              const StencilAxis& a) {
+                                              const Ax& a) {
   const float d2c = (a.lo || a.hi) ? 0.f : p - 2.f * c + m;
   const float d2m = a.lo2 ? 0.f : c - 2.f * m + mm;
   const float d2p = a.hi2 ? 0.f : pp - 2.f * p + c;
@@ -131,9 +199,9 @@ VISOPT_HD VISOPT_INLINE OneSided oneSidedEno2(float mm, float m, float c, float 
 }
 
 // The upwind differences of the given order (1 or 2) along one axis.
-template <class A, int Order>
+template <class A, int Order, class Ax>
 VISOPT_HD VISOPT_INLINE OneSided upwindDifferences(const A& f, int64_t s, float m, float c, float p,
-                                                   const StencilAxis& a) {
+                                                   const Ax& a) {
   if constexpr (Order == 2)
     return oneSidedEno2(f.load(size_t(s + a.mm)), m, c, p, f.load(size_t(s + a.pp)), a);
   else
@@ -232,6 +300,75 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
   return sums;
 }
 
+// sweepStepRow: the CPU row of a kernel that also provides masked(v) and nextAt(v, masked, ax,
+// ay, az) for any mix of StencilAxis and InnerAxis (the level-set step). Rows at least two voxels
+// from the y and z borders use InnerAxis on all three axes, so the interior carries no border
+// selects; a chunk computes unmasked values into local arrays before it stores, so no store can
+// alias a load and the chunk vectorises, then redoes its masked voxels one by one. A row whose
+// interior is not a whole number of chunks ends with a chunk that overlaps the previous one: its
+// stores repeat the same values and its lanes already counted are left out of the sums.
+template <class K, class AY, class AZ>
+VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const AZ& az) {
+  constexpr int kLanes = 16;
+  const int nx = k.dims.x;
+  const size_t base = size_t(r) * size_t(nx);
+  ChangeSums sums;
+  auto single = [&](int i) {
+    const size_t v = base + size_t(i);
+    const float c = k.current(v);
+    const float next = k.nextAt(v, k.masked(v), stencilAxis(i, nx, 1, k.spacing.x), ay, az);
+    k.write(v, next);
+    sums.add(k.kept(next) - c);
+  };
+  const int lo = nx < 2 ? nx : 2;
+  const int hi = nx - 2 > lo ? nx - 2 : lo;
+  if (hi - lo < kLanes) {
+    for (int i = 0; i < nx; ++i) single(i);
+    return sums;
+  }
+  for (int i = 0; i < lo; ++i) single(i);
+  const InnerAxis ax = innerAxis(1, k.spacing.x);
+  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes];
+  for (int l = 0; l < kLanes; ++l) maxAbs[l] = sumAbs[l] = sumSquared[l] = 0.f;
+  for (int done = lo; done < hi;) {
+    const int i0 = done + kLanes <= hi ? done : hi - kLanes;
+    const size_t v0 = base + size_t(i0);
+    float current[kLanes], next[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      current[l] = k.current(v0 + size_t(l));
+      next[l] = k.nextAt(v0 + size_t(l), false, ax, ay, az);
+    }
+    for (int l = 0; l < kLanes; ++l)
+      if (k.masked(v0 + size_t(l))) next[l] = k.nextAt(v0 + size_t(l), true, ax, ay, az);
+    for (int l = 0; l < kLanes; ++l) {
+      k.write(v0 + size_t(l), next[l]);
+      const float d = i0 + l >= done ? k.kept(next[l]) - current[l] : 0.f;
+      maxAbs[l] = maxOf(maxAbs[l], fabsf(d));
+      sumAbs[l] += fabsf(d);
+      sumSquared[l] += d * d;
+    }
+    done = i0 + kLanes;
+  }
+  for (int i = hi; i < nx; ++i) single(i);
+  for (int l = 0; l < kLanes; ++l) {
+    sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
+    sums.sumAbs += double(sumAbs[l]);
+    sums.sumSquared += double(sumSquared[l]);
+  }
+  return sums;
+}
+
+template <class K>
+VISOPT_HD ChangeSums sweepStepRow(const K& k, int64_t r) {
+  const int ny = k.dims.y, nz = k.dims.z;
+  const int j = int(r % ny), l = int(r / ny);
+  const int64_t sy = k.dims.x, sz = int64_t(k.dims.x) * ny;
+  if (j >= 2 && j < ny - 2 && l >= 2 && l < nz - 2)
+    return sweepStepRowWith(k, r, innerAxis(sy, k.spacing.y), innerAxis(sz, k.spacing.z));
+  return sweepStepRowWith(k, r, stencilAxis(j, ny, sy, k.spacing.y),
+                          stencilAxis(l, nz, sz, k.spacing.z));
+}
+
 // ---- the level-set step -----------------------------------------------------------------------
 
 template <class A, int Order>
@@ -250,15 +387,23 @@ struct LevelSetStepKernel {
   VISOPT_HD VISOPT_INLINE void write(size_t v, float x) const { out.store(v, x); }
   VISOPT_HD VISOPT_INLINE float kept(float x) const { return out.kept(x); }
 
+  VISOPT_HD VISOPT_INLINE bool masked(size_t v) const { return mask.valid() && mask.get(v); }
+
   VISOPT_HD VISOPT_INLINE float next(size_t v, const StencilAxis& ax, const StencilAxis& ay,
                                      const StencilAxis& az) const {
+    return nextAt(v, masked(v), ax, ay, az);
+  }
+
+  // The new value at v for the given mask bit and stencil axes (StencilAxis or InnerAxis).
+  template <class AX, class AY, class AZ>
+  VISOPT_HD VISOPT_INLINE float nextAt(size_t v, bool isMasked, const AX& ax, const AY& ay,
+                                       const AZ& az) const {
     const int64_t s = int64_t(v);
     const float c = phi.load(v);
     const float xm = phi.load(size_t(s + ax.m)), xp = phi.load(size_t(s + ax.p));
     const float ym = phi.load(size_t(s + ay.m)), yp = phi.load(size_t(s + ay.p));
     const float zm = phi.load(size_t(s + az.m)), zp = phi.load(size_t(s + az.p));
     const float g = ghat.load(v);
-    const bool masked = mask.valid() && mask.get(v);
 
     const OneSided dx = oneSided(xm, c, xp, ax), dy = oneSided(ym, c, yp, ay),
                    dz = oneSided(zm, c, zp, az);
@@ -268,7 +413,7 @@ struct LevelSetStepKernel {
                 pz = (zp - zm) * az.central;
     const float pxx = (dx.dp - dx.dm) * ax.inv, pyy = (dy.dp - dy.dm) * ay.inv,
                 pzz = (dz.dp - dz.dm) * az.inv;
-    auto mixed = [&](const StencilAxis& a, const StencilAxis& b) {
+    auto mixed = [&](const auto& a, const auto& b) {
       const float pp = phi.load(size_t(s + a.p + b.p)), pm = phi.load(size_t(s + a.p + b.m));
       const float mp = phi.load(size_t(s + a.m + b.p)), mm = phi.load(size_t(s + a.m + b.m));
       return (pp - pm - mp + mm) * a.central * b.central;
@@ -293,14 +438,15 @@ struct LevelSetStepKernel {
     const float gx = (ghat.load(size_t(s + ax.p)) - ghat.load(size_t(s + ax.m))) * ax.central;
     const float gy = (ghat.load(size_t(s + ay.p)) - ghat.load(size_t(s + ay.m))) * ay.central;
     const float gz = (ghat.load(size_t(s + az.p)) - ghat.load(size_t(s + az.m))) * az.central;
-    const float drive = masked ? 0.f : maxOf(0.f, g * upwind * kappa + gx * px + gy * py + gz * pz);
+    const float drive =
+        isMasked ? 0.f : maxOf(0.f, g * upwind * kappa + gx * px + gy * py + gz * pz);
     // The relaxation never overshoots phi0, whatever dt the caller chose.
     const float rate = minOf(maxOf(0.f, lambda - g) * dt, 1.f);
     return c + dt * drive + rate * (phi0.load(v) - c);
   }
 
   VISOPT_HD ChangeSums voxel(int64_t v) const { return sweepVoxel(*this, v); }
-  VISOPT_HD ChangeSums row(int64_t r) const { return sweepRow(*this, r); }
+  VISOPT_HD ChangeSums row(int64_t r) const { return sweepStepRow(*this, r); }
 };
 
 // Maxima over the grid that bound the stable time step (METHODS.md §3).

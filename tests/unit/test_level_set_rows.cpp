@@ -1,0 +1,181 @@
+// The level-set step's vectorised CPU row loop (kernels/level_set_step.h, sweepStepRow) against
+// the per-voxel path the CUDA backend runs (sweepVoxel), and the integer fp16 conversions that
+// row loop uses against the reference conversions of core/half.h.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/device_bit_mask.h"
+#include "core/half.h"
+#include "kernels/level_set_step.h"
+
+using namespace visopt;
+
+namespace {
+
+uint32_t bitsOf(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, 4);
+  return u;
+}
+
+float floatOf(uint32_t u) {
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+
+}  // namespace
+
+TEST(Fp16RowConversions, EveryHalfWidensToTheSameFloat) {
+  int nan = 0;
+  for (uint32_t b = 0; b < 65536u; ++b) {
+    const Half h{uint16_t(b)};
+    const float ref = halfToFloat(h), row = halfToFloatRow(h);
+    if (std::isnan(ref)) {
+      ++nan;
+      ASSERT_TRUE(std::isnan(row)) << std::hex << b;
+      ASSERT_EQ(std::signbit(ref), std::signbit(row)) << std::hex << b;
+    } else {
+      ASSERT_EQ(bitsOf(ref), bitsOf(row)) << std::hex << b << " " << ref << " " << row;
+    }
+  }
+  EXPECT_EQ(nan, 2 * 1023);  // the test saw every NaN pattern
+}
+
+// Every float of magnitude <= 65504 whose dropped 13 mantissa bits sit at or next to a rounding
+// boundary (the ties and their neighbours), every subnormal-half range float with a stride, and
+// a strided sweep of the rest.
+TEST(Fp16RowConversions, NarrowingRoundsLikeTheReference) {
+  const uint32_t top = bitsOf(65504.f);
+  size_t checked = 0;
+  auto check = [&](uint32_t u) {
+    if (u > top) return;
+    for (uint32_t sign : {0u, 0x80000000u}) {
+      const float v = floatOf(u | sign);
+      const Half ref = floatToHalf(v), row = floatToHalfRow(v);
+      ASSERT_EQ(ref.bits, row.bits) << std::hex << (u | sign) << " " << v;
+      ++checked;
+    }
+  };
+  for (uint32_t hi = 0; hi <= (top >> 13); ++hi)
+    for (uint32_t lo : {0x0000u, 0x0001u, 0x0fffu, 0x1000u, 0x1001u, 0x1fffu})
+      check((hi << 13) | lo);
+  for (uint32_t u = 0; u < bitsOf(0x1p-14f); u += 61) check(u);  // halves' subnormals and below
+  for (uint32_t u = 0; u <= top; u += 4099) check(u);
+  std::printf("fp16 narrowing: %zu floats checked\n", checked);
+  EXPECT_GT(checked, 1000000u);
+}
+
+namespace {
+
+struct Case {
+  glm::ivec3 dims;
+  bool fp16;
+  bool withMask;
+  int order;
+};
+
+template <class A, int Order>
+void compareRowsWithVoxels(const Case& c) {
+  using Store = std::conditional_t<std::is_same_v<A, Fp16Access>, Half, float>;
+  const size_t n = size_t(c.dims.x) * size_t(c.dims.y) * size_t(c.dims.z);
+  std::mt19937 rng(1234);
+  std::uniform_real_distribution<float> noise(-0.3f, 0.3f), unit(0.f, 1.f);
+  auto store = [](float v) {
+    if constexpr (std::is_same_v<Store, Half>)
+      return floatToHalf(v);
+    else
+      return v;
+  };
+  std::vector<Store> phi(n), phi0(n), ghat(n), outRows(n), outVoxels(n);
+  const glm::vec3 centre = glm::vec3(c.dims) * 0.5f + glm::vec3(0.3f, -0.2f, 0.1f);
+  const float radius = 0.3f * float(std::min({c.dims.x, c.dims.y, c.dims.z}));
+  for (int k = 0; k < c.dims.z; ++k)
+    for (int j = 0; j < c.dims.y; ++j)
+      for (int i = 0; i < c.dims.x; ++i) {
+        const size_t v = (size_t(k) * size_t(c.dims.y) + size_t(j)) * size_t(c.dims.x) + size_t(i);
+        const float d = glm::length(glm::vec3(i, j, k) - centre) - radius;
+        phi[v] = store(d + noise(rng));
+        phi0[v] = store(d);
+        ghat[v] = store(unit(rng));
+      }
+  DeviceBitMask mask(c.dims, "mask", nullptr);
+  if (c.withMask)
+    for (size_t w = 0; w < DeviceBitMask::wordCount(c.dims); ++w)
+      mask.words()[w] = uint8_t(rng() & 0x91u);  // about a third of the voxels
+  LevelSetStepKernel<A, Order> k;
+  k.phi = A{phi.data()};
+  k.phi0 = A{phi0.data()};
+  k.ghat = A{ghat.data()};
+  if (c.withMask) k.mask = mask.view();
+  k.dims = c.dims;
+  k.spacing = glm::vec3(1.f, 1.3f, 0.7f);
+  k.dt = 0.05f;
+  k.lambda = 0.4f;
+  k.kappaMax = 1.f / 0.7f;
+
+  k.out = A{outVoxels.data()};
+  ChangeSums voxels;
+  for (int64_t v = 0; v < int64_t(n); ++v) voxels = voxels + k.voxel(v);
+  k.out = A{outRows.data()};
+  ChangeSums rows;
+  for (int64_t r = 0; r < int64_t(c.dims.y) * c.dims.z; ++r) rows = rows + k.row(r);
+
+  size_t differ = 0;
+  for (size_t v = 0; v < n; ++v) {
+    float a, b;
+    if constexpr (std::is_same_v<Store, Half>) {
+      a = halfToFloat(outRows[v]);
+      b = halfToFloat(outVoxels[v]);
+    } else {
+      a = outRows[v];
+      b = outVoxels[v];
+    }
+    ASSERT_TRUE(std::isfinite(a)) << v;
+    // The vector code may contract a*b+c into an FMA: a few ulps of fp32, never more, which in
+    // fp16 storage can at most round to the neighbouring half.
+    const float ulps = std::is_same_v<Store, Half> ? 1e-3f : 1e-6f;
+    ASSERT_NEAR(a, b, ulps * std::max(1.f, std::fabs(b))) << "voxel " << v;
+    differ += a != b;
+  }
+  std::printf("%dx%dx%d %s order %d%s: %zu of %zu voxels differ in the last bits\n", c.dims.x,
+              c.dims.y, c.dims.z, c.fp16 ? "fp16" : "fp32", Order, c.withMask ? " masked" : "",
+              differ, n);
+  const double rel = std::is_same_v<Store, Half> ? 1e-3 : 1e-5;
+  EXPECT_NEAR(rows.maxAbs, voxels.maxAbs, rel * std::max(1.f, voxels.maxAbs));
+  EXPECT_NEAR(rows.sumAbs, voxels.sumAbs, rel * std::max(1.0, voxels.sumAbs));
+  EXPECT_NEAR(rows.sumSquared, voxels.sumSquared, rel * std::max(1.0, voxels.sumSquared));
+  EXPECT_GT(voxels.sumAbs, 0.0) << "the step moved something";
+}
+
+void compare(const Case& c) {
+  if (c.fp16)
+    c.order == 1 ? compareRowsWithVoxels<Fp16Access, 1>(c)
+                 : compareRowsWithVoxels<Fp16Access, 2>(c);
+  else
+    c.order == 1 ? compareRowsWithVoxels<Fp32Access, 1>(c)
+                 : compareRowsWithVoxels<Fp32Access, 2>(c);
+}
+
+}  // namespace
+
+// Rows of 37 voxels: two 16-voxel chunks whose second overlaps the first (33 interior voxels),
+// rows of 20 (exactly one chunk), rows too short for a chunk, and face rows in y and z.
+TEST(LevelSetRows, RowLoopMatchesThePerVoxelPath) {
+  for (glm::ivec3 dims :
+       {glm::ivec3(37, 9, 7), glm::ivec3(20, 6, 5), glm::ivec3(11, 5, 6), glm::ivec3(37, 1, 3)})
+    for (bool fp16 : {false, true})
+      for (bool withMask : {false, true})
+        for (int order : {1, 2}) {
+          SCOPED_TRACE(testing::Message()
+                       << dims.x << "x" << dims.y << "x" << dims.z << (fp16 ? " fp16" : " fp32")
+                       << " order " << order << (withMask ? " masked" : ""));
+          compare(Case{dims, fp16, withMask, order});
+        }
+}

@@ -6,6 +6,7 @@
 
 #include <QApplication>
 #include <QCommandLineParser>
+#include <QDockWidget>
 #include <QElapsedTimer>
 #include <QTimer>
 
@@ -13,6 +14,7 @@
 
 #include "camera_navigation.h"
 #include "main_window.h"
+#include "panels/deviation_panel.h"
 #include "viewport_widget.h"
 
 using namespace visopt;
@@ -96,8 +98,13 @@ int main(int argc, char** argv) {
                             QStringLiteral("Save the session after the first converged frame "
                                            "and quit."),
                             QStringLiteral("FILE"));
+  QCommandLineOption deviation(QStringLiteral("deviation-view"),
+                               QStringLiteral("Start with the deviation view on."));
+  QCommandLineOption tab(QStringLiteral("show-panel"),
+                         QStringLiteral("Bring the dock panel with this title to the front."),
+                         QStringLiteral("TITLE"));
   parser.addOptions({scene, volume, session, resolution, screenshot, windowShot, size, noOptimize,
-                     latency, stateDir, timeout, saveTo});
+                     latency, stateDir, timeout, saveTo, deviation, tab});
   parser.process(app);
 
   const bool scripted = parser.isSet(screenshot) || parser.isSet(windowShot) ||
@@ -128,6 +135,17 @@ int main(int argc, char** argv) {
     if (name.isEmpty()) name = QString::fromStdString(defaultSceneName());
     window.openBuiltinScene(name, parser.value(resolution).toInt());
   }
+
+  if (parser.isSet(deviation)) {
+    window.deviationPanel()->setDeviationSettings(true, Colormap::Viridis, 4.f);
+    emit window.deviationPanel()->deviationSettingsChanged(true, Colormap::Viridis, 4.f);
+  }
+  for (const QString& title : parser.values(tab))
+    for (QDockWidget* dock : window.findChildren<QDockWidget*>())
+      if (dock->windowTitle().compare(title, Qt::CaseInsensitive) == 0) {
+        dock->show();
+        dock->raise();
+      }
 
   if (!scripted) return app.exec();
 

@@ -227,7 +227,8 @@ void MainWindow::buildDocks() {
                                   [p = path.toStdString()](Engine& e, const ProgressCallback&) {
                                     e.loadImportance(p);
                                   });
-            importanceEditor_->setImportanceVolumeName(QFileInfo(path).fileName());
+            importanceEditor_->setImportanceVolumeName(
+                tr("the volume %1").arg(QFileInfo(path).fileName()));
             setModified();
           });
   connect(importanceEditor_, &ImportanceEditor::overlayToggled, this, [this](bool on) {
@@ -615,7 +616,7 @@ void MainWindow::applySessionToPanels(const Session& s) {
     importanceEditor_->setImportanceVolumeName({});
   } else if (s.importance.kind == SessionImportance::Kind::Volume) {
     importanceEditor_->setImportanceVolumeName(
-        QFileInfo(fromStd(s.importance.volume.absolutePath)).fileName());
+        tr("the volume %1").arg(QFileInfo(fromStd(s.importance.volume.absolutePath)).fileName()));
   } else if (s.importance.kind == SessionImportance::Kind::Scene) {
     importanceEditor_->setImportanceVolumeName(tr("the scene's definition"));
   }

@@ -81,7 +81,7 @@ std::vector<glm::dvec2> ImportanceEditor::curve() const {
 
 void ImportanceEditor::setImportanceVolumeName(const QString& name) {
   volumeName_ = name;
-  volumeLabel_->setText(tr("from volume %1").arg(name));
+  volumeLabel_->setText(tr("Importance from %1; editing the curve replaces it").arg(name));
   volumeLabel_->setToolTip(name);
   volumeLabel_->setVisible(!name.isEmpty());
 }

@@ -273,6 +273,50 @@ TEST_P(LevelSet, RedistancingFollowsTheInteriorAtTheFaces) {
   EXPECT_LT(zeroSetDrift(phi, centre, radius), 0.1f);
 }
 
+// With the surface's base SDF given, redistancing leaves every voxel where phi is still phi0
+// exactly as it is (phi0 need not be an exact distance: here it is 10 % off, as a sampled
+// base is by a little), and redistances where the surface moved: the half of the grid where
+// phi was scaled (|grad phi| = 2) becomes a distance again. Without the base the unmoved half
+// changes too.
+TEST_P(LevelSet, RedistancingWithTheBaseHoldsWhatDidNotMove) {
+  const GridSpec g = cube(32);
+  const glm::vec3 centre(15.6f, 16.3f, 15.9f);
+  const float radius = 9.f;
+  const Fn exact = sphere(centre, radius);
+  const Fn base = [&](glm::vec3 x) { return 1.1f * exact(x); };
+  const Field3D phi0 = makeField("phi0", g, GetParam(), base);
+  const Fn moved = [&](glm::vec3 x) { return x.x < centre.x - 2.f ? 2.f * exact(x) : base(x); };
+  Field3D phi = makeField("phi", g, GetParam(), moved);
+  Field3D without = makeField("phi", g, GetParam(), moved);
+  Field3D scratch;
+  LevelSetSettings s;
+  s.redistanceIterations = 200;
+  s.redistanceTolerance = 1e-7f;
+  redistance(phi, s, scratch, &phi0);
+  redistance(without, s, scratch);
+  float heldChange = 0.f, withoutChange = 0.f, movedError = 0.f;
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = 0; j < g.dims.y; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const size_t v = g.linearIndex(i, j, k);
+        const glm::vec3 x = g.indexToWorld(glm::vec3(i, j, k));
+        if (x.x >= centre.x) {
+          heldChange = std::max(heldChange, std::fabs(phi.get(v) - phi0.get(v)));
+          withoutChange = std::max(withoutChange, std::fabs(without.get(v) - phi0.get(v)));
+        } else if (x.x < centre.x - 4.f && std::fabs(exact(x)) < 3.f) {
+          movedError = std::max(movedError, std::fabs(phi.get(v) - exact(x)));
+        }
+      }
+  std::printf(
+      "redistancing with the base (%s): unmoved half changed by %.3g (without the base %.3g), "
+      "moved half within %.3f voxel of the distance near the surface\n",
+      toString(GetParam()), heldChange, withoutChange, movedError);
+  EXPECT_EQ(heldChange, 0.f);
+  EXPECT_GT(withoutChange, 0.1f);
+  EXPECT_LT(movedError, 0.5f);
+  EXPECT_LT(zeroSetDrift(phi, centre, radius), 0.2f);
+}
+
 // ---- an SDF from an isovalue; thin shells -------------------------------------------------
 
 // s = exp(-r^2 / (2 sigma^2)) in data units [100, 1100], isosurface at r = R: a sphere SDF

@@ -546,8 +546,9 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   // voxel from the surface.
   auto t1 = Clock::now();
   if (L.motionSinceRedistance >= 0.5 * double(L.grid.minSpacing())) {
-    for (auto& phi : L.phi) {
-      RedistanceStats rs = redistance(phi, in.levelSet, *L.scratch);
+    for (size_t si = 0; si < L.phi.size(); ++si) {
+      const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
+      RedistanceStats rs = redistance(L.phi[si], in.levelSet, *L.scratch, &phi0);
       st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
       st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
     }

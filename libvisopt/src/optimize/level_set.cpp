@@ -137,11 +137,16 @@ ChangeSums substep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
 }
 
 template <class A, int Order>
-double redistancePassWith(const Field3D& in, Field3D& out, bool initialise) {
+double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, const Field3D* base) {
   const GridSpec& g = in.grid();
   RedistanceKernel<A, Order> k;
   k.in = accessOf(in, Tag<A>{});
   k.out = accessOf(out, Tag<A>{});
+  if (base) {
+    k.base = accessOf(*base, Tag<A>{});
+    k.hasBase = true;
+    k.keepWithin = kRedistanceKeepsBaseWithin * g.minSpacing();
+  }
   k.dims = g.dims;
   k.spacing = g.spacing;
   k.dxMin = g.minSpacing();
@@ -151,12 +156,14 @@ double redistancePassWith(const Field3D& in, Field3D& out, bool initialise) {
   return c.sumSquared / (double(k.dxMin) * k.dxMin) / double(in.size());
 }
 
-double redistancePass(const Field3D& in, Field3D& out, bool initialise, int order) {
-  return dispatch({&in, &out}, [&](auto tag) {
+double redistancePass(const Field3D& in, Field3D& out, bool initialise, int order,
+                      const Field3D* base = nullptr) {
+  auto run = [&](auto tag) {
     using A = typename decltype(tag)::type;
-    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise)
-                      : redistancePassWith<A, 2>(in, out, initialise);
-  });
+    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base)
+                      : redistancePassWith<A, 2>(in, out, initialise, base);
+  };
+  return base ? dispatch({&in, &out, base}, run) : dispatch({&in, &out}, run);
 }
 
 }  // namespace
@@ -219,8 +226,10 @@ double redistanceIteration(const Field3D& in, Field3D& out, int spatialOrder) {
   return redistancePass(in, out, false, spatialOrder);
 }
 
-RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch) {
+RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
+                           const Field3D* base) {
   requireSameGrid(phi, phi, "phi");
+  if (base) requireSameGrid(phi, *base, "the base SDF");
   checkOrder(s);
   ensureLike(scratch, phi);
   RedistanceStats stats;
@@ -234,7 +243,7 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
   Field3D* to = &scratch;
   for (int n = 0; n < s.redistanceIterations; ++n) {
     // The first pass also sets the interface band to its subcell distance (kept afterwards).
-    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder);
+    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder, base);
     stats.iterations = n + 1;
     std::swap(from, to);
     if (stats.meanSquaredChange < double(s.redistanceTolerance)) {

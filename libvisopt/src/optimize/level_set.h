@@ -30,8 +30,12 @@ double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s);
 // stopping early when the mean squared change per iteration (voxel units^2) falls below
 // s.redistanceTolerance; see kernels/redistance.h for the scheme (subcell fix at the interface,
 // dtau). A field without any sign change has no interface to measure distance
-// from: it is left unchanged (0 iterations, converged).
-RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch);
+// from: it is left unchanged (0 iterations, converged). With `base` (the surface's phi0, on
+// phi's grid) every voxel within kRedistanceKeepsBaseWithin voxels of phi0 keeps its value:
+// only where the surface moved is it redistanced, and elsewhere it stays exactly in place.
+inline constexpr float kRedistanceKeepsBaseWithin = 0.05f;
+RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
+                           const Field3D* base = nullptr);
 
 // Single passes, for the benchmark: one Euler substep of Eq. 23 with a given dt from `phi`
 // into `out` (returns max |delta phi|), and one redistancing iteration from `in` into `out`

@@ -49,6 +49,8 @@ struct Engine::Impl {
   ExtinctionOptimizer optimizer{&ledger, Precision::FP32};
   bool frozen = false;
   bool renderOptimized = true;
+  // The optimised mu as the renderer draws it (render/renderer.h), refreshed at each render.
+  std::optional<Field3D> extinctionChange;
   int viewportWidth = 512, viewportHeight = 512;
 
   explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
@@ -122,7 +124,8 @@ struct Engine::Impl {
     s.camera = camera;
     s.light = light;
     const bool useOptimized = optimized && renderOptimized;
-    if (useOptimized) s.extinction = optimizer.extinction();
+    if (useOptimized && optimizer.extinction() && extinctionChange)
+      s.extinctionChange = &*extinctionChange;
     const auto phis = optimizer.surfaces();
     for (size_t i = 0; i < surfaceSpecs.size(); ++i) {
       if (!surfaceSpecs[i].visible) continue;
@@ -138,6 +141,20 @@ struct Engine::Impl {
       s.lightTransmittance = &*lightTransmittance;
     }
     return s;
+  }
+
+  // Allocated only while an optimised mu is drawn.
+  void updateExtinctionChange(bool optimized) {
+    const Field3D* mu = optimizer.extinction();
+    if (!optimized || !renderOptimized || !mu) {
+      extinctionChange.reset();
+      return;
+    }
+    const GridSpec& g = volume->grid();
+    if (!extinctionChange || extinctionChange->grid() != g ||
+        extinctionChange->precision() != precision)
+      extinctionChange.emplace("extinction-change (render)", g, precision, &ledger);
+    computeExtinctionChange(*volume, table, *mu, *extinctionChange);
   }
 
   double ensureLight(const RenderSettings& settings) {
@@ -259,6 +276,7 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
   const bool optimized = settings.method == RenderMethod::Optimized;
   if (optimized != impl_->lightOptimized) impl_->lightDirty = true;  // T_L of the other scene
   impl_->lightOptimized = optimized;
+  impl_->updateExtinctionChange(optimized);
   double lightMs = impl_->ensureLight(settings);
   Image image = renderImage(impl_->scene(optimized), settings, stats);
   if (stats) stats->lightMilliseconds = lightMs;

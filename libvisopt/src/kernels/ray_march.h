@@ -38,6 +38,7 @@
 #include "kernels/ray_stencil.h"
 #include "kernels/surface_render.h"
 #include "kernels/transfer_lookup.h"
+#include "kernels/volume_extinction.h"
 
 namespace visopt {
 
@@ -83,8 +84,10 @@ inline int64_t rayMarchItems(int w, int h) {
 struct RayMarchParams {
   FrustumMap camera;  // dims.x, dims.y = image size
   GridMap volume;
-  FieldView scalars;     // normalised scalars
-  FieldView extinction;  // optimised mu; invalid -> mu_bar from the transfer function
+  FieldView scalars;  // normalised scalars
+  // The optimised mu as its change to mu_bar per voxel (kernels/volume_extinction.h);
+  // invalid -> mu_bar from the transfer function alone.
+  FieldView extinctionChange;
   TransferLookup transfer;
   FrustumMap light;
   FieldView lightTransmittance;  // T_L on the light frustum grid; invalid -> unshadowed
@@ -260,9 +263,10 @@ struct RayMarchKernel {
           const glm::vec3 q = p.volume.toIndex(x + dist * n);
           const glm::vec3 hi = glm::vec3(p.volume.dims - 1);
           if (q.x < 0.f || q.y < 0.f || q.z < 0.f || q.x > hi.x || q.y > hi.y || q.z > hi.z) break;
-          const float mu = p.extinction.valid()
-                               ? raySample(p.extinction, q)
-                               : p.transfer.extinction(p.transfer.locate(raySample(p.scalars, q)));
+          const float base = p.transfer.extinction(p.transfer.locate(raySample(p.scalars, q)));
+          const float mu = p.extinctionChange.valid()
+                               ? extinctionWithChange(base, raySample(p.extinctionChange, q))
+                               : base;
           depth += mu * 0.25f * p.surf.aoRadius;
         }
         volumeOcclusion = expf(-depth);
@@ -322,8 +326,9 @@ struct RayMarchKernel {
         RayVoxels<T> voxels(scalars, dims, idx);
         const float value = voxels.value();
         const TransferLookup::Entry entry = p.transfer.locate(value);
-        float mu =
-            p.extinction.valid() ? raySample(p.extinction, idx) : p.transfer.extinction(entry);
+        float mu = p.transfer.extinction(entry);
+        if (p.extinctionChange.valid())
+          mu = extinctionWithChange(mu, raySample(p.extinctionChange, idx));
         if (method == RayMethod::CutAway || method == RayMethod::Transparency) {
           // Occluders in front of important structures go (cut-away) or fade (transparency
           // modulation); the important structures themselves stay.

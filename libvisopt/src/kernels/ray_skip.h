@@ -6,13 +6,13 @@
 //
 // Built per frame in two passes (cheap next to rendering, and only when the transfer function
 // has transparent ranges or mu is an optimised field):
-//  1. RaySkipRange: the range [lo, hi] of the field (normalised scalars, or the optimised mu)
-//     over each block's voxels;
+//  1. RaySkipRange: the range [lo, hi] of the normalised scalars over each block's voxels, and
+//     with an optimised mu also that of its change to mu_bar;
 //  2. RaySkipFlags: a block is empty when the union of the ranges of its 3x3x3 neighbourhood
 //     (which covers every voxel a trilinear sample inside the block, or within rounding of its
-//     faces, can read) maps only to negligible extinction: through the transfer function's
-//     table (any entry between the range's table cells, one more on each side) or, for the
-//     optimised mu, directly.
+//     faces, can read) maps only to negligible extinction through the transfer function's
+//     table (any entry between the range's table cells, one more on each side), and the change
+//     to it is nowhere positive there.
 #pragma once
 
 #include <cstdint>
@@ -65,41 +65,38 @@ struct RaySkipRange {
   }
 };
 
-// Pass 2: the empty flags. With a transfer table, nonEmptyBefore[i] counts the table entries
-// before i whose extinction is not negligible; without (optimised mu), the range is mu itself.
+// Pass 2: the empty flags. nonEmptyBefore[i] counts the transfer table's entries before i whose
+// extinction is not negligible.
 struct RaySkipFlags {
   glm::ivec3 blocks{0};
   const glm::vec2* range = nullptr;
-  const int* nonEmptyBefore = nullptr;  // size tableSize + 1, or null for an extinction field
+  const glm::vec2* changeRange = nullptr;  // of mu - mu_bar, or null without an optimised mu
+  const int* nonEmptyBefore = nullptr;     // size tableSize + 1
   int tableSize = 0;
-  float maxNegligibleExtinction = 0.f;  // for an extinction field
   uint8_t* empty = nullptr;
 
   VISOPT_HD void operator()(int64_t block) const {
     const int bx = int(block % blocks.x), by = int((block / blocks.x) % blocks.y),
               bz = int(block / (int64_t(blocks.x) * blocks.y));
-    float lo = 3.0e38f, hi = -3.0e38f;
+    float lo = 3.0e38f, hi = -3.0e38f, changeHi = -3.0e38f;
     for (int k = bz - 1; k <= bz + 1; ++k)
       for (int j = by - 1; j <= by + 1; ++j)
         for (int i = bx - 1; i <= bx + 1; ++i) {
           if (i < 0 || j < 0 || k < 0 || i >= blocks.x || j >= blocks.y || k >= blocks.z) continue;
-          const glm::vec2 r = range[(int64_t(k) * blocks.y + j) * blocks.x + i];
+          const int64_t b = (int64_t(k) * blocks.y + j) * blocks.x + i;
+          const glm::vec2 r = range[b];
           lo = r.x < lo ? r.x : lo;
           hi = r.y > hi ? r.y : hi;
+          if (changeRange) changeHi = changeRange[b].y > changeHi ? changeRange[b].y : changeHi;
         }
-    bool isEmpty;
-    if (nonEmptyBefore) {
-      // The table cells the clamped values fall in, widened by one entry against rounding.
-      const float scale = float(tableSize - 1);
-      const float a = (lo < 0.f ? 0.f : (lo > 1.f ? 1.f : lo)) * scale;
-      const float b = (hi < 0.f ? 0.f : (hi > 1.f ? 1.f : hi)) * scale;
-      int first = int(a) - 1, last = int(b) + 2;
-      first = first < 0 ? 0 : first;
-      last = last > tableSize - 1 ? tableSize - 1 : last;
-      isEmpty = nonEmptyBefore[last + 1] - nonEmptyBefore[first] == 0;
-    } else {
-      isEmpty = hi <= maxNegligibleExtinction;
-    }
+    // The table cells the clamped values fall in, widened by one entry against rounding.
+    const float scale = float(tableSize - 1);
+    const float a = (lo < 0.f ? 0.f : (lo > 1.f ? 1.f : lo)) * scale;
+    const float b = (hi < 0.f ? 0.f : (hi > 1.f ? 1.f : hi)) * scale;
+    int first = int(a) - 1, last = int(b) + 2;
+    first = first < 0 ? 0 : first;
+    last = last > tableSize - 1 ? tableSize - 1 : last;
+    const bool isEmpty = nonEmptyBefore[last + 1] - nonEmptyBefore[first] == 0 && !(changeHi > 0.f);
     empty[block] = isEmpty ? 1 : 0;
   }
 };

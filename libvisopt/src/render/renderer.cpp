@@ -24,7 +24,7 @@ TransferLookup lookupOf(const RenderScene& scene) {
 VolumeExtinction extinctionOf(const RenderScene& scene) {
   VolumeExtinction e;
   e.scalars = FieldView(scene.volume->normalized);
-  if (scene.extinction) e.extinction = FieldView(*scene.extinction);
+  if (scene.extinctionChange) e.change = FieldView(*scene.extinctionChange);
   e.transfer = lookupOf(scene);
   return e;
 }
@@ -52,7 +52,7 @@ Image upscale(const Image& small, int width, int height) {
 // an invalid grid when nothing can be skipped: the transfer function has no transparent range
 // and mu is not an optimised field.
 struct SkipGridStorage {
-  DeviceBuffer<glm::vec2> range;
+  DeviceBuffer<glm::vec2> range, changeRange;
   DeviceBuffer<int> nonEmptyBefore;
   DeviceBuffer<uint8_t> empty;
   RaySkipGrid grid;
@@ -63,30 +63,33 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
   // threshold (with a margin for rounding in the interpolations and the segment length).
   const float negligible = kRayMinOpticalDepth / (step * 1.001f);
   RaySkipFlags flags;
-  if (!scene.extinction) {
-    const DeviceBuffer<glm::vec4>& table = *scene.transfer;
-    out.nonEmptyBefore = DeviceBuffer<int>(table.size() + 1);
-    int count = 0;
-    for (size_t i = 0; i < table.size(); ++i) {
-      out.nonEmptyBefore[i] = count;
-      if (!(table[i].w < negligible)) ++count;
-    }
-    out.nonEmptyBefore[table.size()] = count;
-    if (count == int(table.size())) return;  // nothing transparent
-    flags.nonEmptyBefore = out.nonEmptyBefore.data();
-    flags.tableSize = int(table.size());
-  } else {
-    // mu is sampled at the volume's index coordinates: only a field on the volume's grid.
-    if (scene.extinction->grid().dims != scene.volume->grid().dims) return;
-    flags.maxNegligibleExtinction = negligible * 0.999f;
+  const DeviceBuffer<glm::vec4>& table = *scene.transfer;
+  out.nonEmptyBefore = DeviceBuffer<int>(table.size() + 1);
+  int count = 0;
+  for (size_t i = 0; i < table.size(); ++i) {
+    out.nonEmptyBefore[i] = count;
+    if (!(table[i].w < negligible)) ++count;
   }
-  const FieldView field =
-      scene.extinction ? FieldView(*scene.extinction) : FieldView(scene.volume->normalized);
-  const glm::ivec3 blocks = raySkipBlocks(field.dims);
+  out.nonEmptyBefore[table.size()] = count;
+  if (count == int(table.size())) return;  // nothing transparent
+  flags.nonEmptyBefore = out.nonEmptyBefore.data();
+  flags.tableSize = int(table.size());
+  // The change is sampled at the volume's index coordinates: only a field on the volume's grid.
+  if (scene.extinctionChange && scene.extinctionChange->grid().dims != scene.volume->grid().dims)
+    return;
+  const FieldView scalars(scene.volume->normalized);
+  const glm::ivec3 blocks = raySkipBlocks(scalars.dims);
   const int64_t n = int64_t(blocks.x) * blocks.y * blocks.z;
   out.range = DeviceBuffer<glm::vec2>(size_t(n));
   out.empty = DeviceBuffer<uint8_t>(size_t(n));
-  exec::parallelFor("render skip ranges", n, RaySkipRange{field, blocks, out.range.data()});
+  exec::parallelFor("render skip ranges", n, RaySkipRange{scalars, blocks, out.range.data()});
+  if (scene.extinctionChange) {
+    out.changeRange = DeviceBuffer<glm::vec2>(size_t(n));
+    exec::parallelFor(
+        "render skip ranges", n,
+        RaySkipRange{FieldView(*scene.extinctionChange), blocks, out.changeRange.data()});
+    flags.changeRange = out.changeRange.data();
+  }
   flags.blocks = blocks;
   flags.range = out.range.data();
   flags.empty = out.empty.data();
@@ -96,6 +99,27 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
 }
 
 }  // namespace
+
+void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
+                             const Field3D& mu, Field3D& out) {
+  if (out.grid().dims != volume.grid().dims)
+    throw Error(ErrorKind::Failure, "the extinction change is not on the volume's grid");
+  const FieldView scalars(volume.normalized), from(mu), to(out);
+  const TransferLookup table{transfer.data(), int(transfer.size())};
+  const GridMap voxels(volume.grid()), muGrid(mu.grid());
+  const bool same = mu.grid().dims == volume.grid().dims;
+  exec::parallelFor("render: extinction change", int64_t(out.size()), [=] VISOPT_HD(int64_t v) {
+    float m;
+    if (same) {
+      m = from.load(size_t(v));
+    } else {
+      const int i = int(v % voxels.dims.x), j = int((v / voxels.dims.x) % voxels.dims.y),
+                k = int(v / (int64_t(voxels.dims.x) * voxels.dims.y));
+      m = from.sample(muGrid.toIndex(voxels.toWorld(glm::vec3(float(i), float(j), float(k)))));
+    }
+    to.store(size_t(v), m - table.at(scalars.load(size_t(v))).w);
+  });
+}
 
 void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
                                Field3D& out) {
@@ -129,7 +153,7 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   p.camera = FrustumMap(FrustumGrid::forCamera(scene.camera, w, h, grid.worldBounds(), 1, 1.f));
   p.volume = GridMap(grid);
   p.scalars = FieldView(scene.volume->normalized);
-  if (scene.extinction) p.extinction = FieldView(*scene.extinction);
+  if (scene.extinctionChange) p.extinctionChange = FieldView(*scene.extinctionChange);
   p.transfer = lookupOf(scene);
   if (scene.lightTransmittance && scene.lightFrustum) {
     p.light = FrustumMap(*scene.lightFrustum);

@@ -18,7 +18,9 @@ namespace visopt {
 
 struct RenderScene {
   const Volume* volume = nullptr;
-  const Field3D* extinction = nullptr;                // optimised mu, or null for mu_bar
+  // The optimised mu as its change to mu_bar per voxel (optimised mu - mu_bar), on the volume's
+  // grid, or null for mu_bar alone (kernels/volume_extinction.h says why not mu itself).
+  const Field3D* extinctionChange = nullptr;
   const DeviceBuffer<glm::vec4>* transfer = nullptr;  // baked table (albedo, extinction)
   Camera camera;
   PointLight light;
@@ -32,6 +34,12 @@ struct RenderScene {
   const Field3D* importance = nullptr;
   BitMaskView worldMask;  // for the world-mask overlay; invalid without a mask
 };
+
+// out = mu - mu_bar on the volume's grid (out's grid), mu_bar from the baked transfer table at
+// each voxel's scalar, mu sampled trilinearly at the voxel's world position (so a coarse
+// level's mu works too): RenderScene::extinctionChange.
+void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
+                             const Field3D& mu, Field3D& out);
 
 // T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h).
 void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,

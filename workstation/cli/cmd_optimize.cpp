@@ -43,6 +43,8 @@ nlohmann::json statsJson(const IterationStats& s) {
           {"redistance_iterations", s.redistanceIterations},
           {"redistance_residual", s.redistanceResidual},
           {"level_set_time_step", s.levelSetTimeStep},
+          {"level_set_substeps", s.levelSetSubsteps},
+          {"level_set_motion_voxels", s.levelSetMotionVoxels},
           {"max_deviation_voxels", s.maxDeviationVoxels},
           {"mean_deviation_voxels", s.meanDeviationVoxels}};
 }
@@ -62,6 +64,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     std::vector<std::string> contexts;
     float shell = -1.f, lambda = -1.f;
     int redistIterations = -1;
+    float reach = -1.f;
     bool filled = false, deviationView = false;
     int resolution = 128, levels = 3, iterations = 60;
     float rho = -1.f, q = 40.f, r = 0.f, lr = 0.05f, muMax = 0.f, frustumScale = 0.5f,
@@ -74,8 +77,10 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--resolution", o->resolution, "Built-in scene resolution (longest axis, voxels)");
   app.add_option("--tf", o->tf, "Transfer function: JSON file (visopt or ParaView) or preset:NAME");
   app.add_option("--importance", o->importance,
-                 "Importance g in [0,1]: a curve JSON {\"points\":[[value,g],...]} or a volume "
-                 "file on the same grid");
+                 "Importance g in [0,1]: preset:NAME (the importance a transfer-function preset "
+                 "is made for, the default with --tf preset:ct-skin-bone or preset:ct-bone: "
+                 "bone), a curve JSON {\"points\":[[value,g],...]} or a volume file on the same "
+                 "grid");
   app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST (degrees, degrees, bounding radii)");
   app.add_option("--light", o->light, "Point light on an orbit AZ,EL,DIST (default: key light)");
   app.add_option("--rho", o->rho,
@@ -95,10 +100,17 @@ Runner addOptimizeCommand(CLI::App& app) {
                  "or vdb:FILE");
   auto* shellOpt = app.add_option("--shell", o->shell,
                                   "Context surfaces as thin shells reaching D (world units) to "
-                                  "either side of the surface (Eq. 26)");
-  app.add_flag("--filled", o->filled, "Context surfaces filled (the default)")->excludes(shellOpt);
+                                  "either side of the surface (Eq. 26; default for iso: one "
+                                  "voxel, for mesh: and vdb: filled)");
+  app.add_flag("--filled", o->filled,
+               "Context surfaces filled (default for mesh: and vdb:; an isosurface of a scan is "
+               "a thin shell unless this is given)")
+      ->excludes(shellOpt);
   app.add_option("--lambda", o->lambda,
                  "How strongly surfaces return to their base shape (Eq. 23)");
+  app.add_option("--level-set-reach", o->reach,
+                 "How far surfaces can travel per run, in bounding radii (default 1; 0: a fixed "
+                 "number of level-set substeps per iteration)");
   app.add_option("--redist-iterations", o->redistIterations,
                  "Redistancing iterations at most (Eq. 18)");
   app.add_option("--world-mask", o->worldMask,
@@ -136,19 +148,51 @@ Runner addOptimizeCommand(CLI::App& app) {
     s.tolerance = o->tolerance;
     s.frustumScale = o->frustumScale;
     const glm::ivec2 size = parseSize(o->size);
-    (void)o->filled;
     loadInput(engine, o->volume, o->scene, o->resolution, !o->json && !o->quiet);
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
-    if (!o->importance.empty()) engine.loadImportance(o->importance);
+    // --importance preset:NAME, or, without --importance, the importance the --tf preset is
+    // made for (bone for the CT presets).
+    std::string importancePreset;
+    if (o->importance.rfind("preset:", 0) == 0)
+      importancePreset = o->importance.substr(7);
+    else if (o->importance.empty() && o->scene.empty() && o->tf.rfind("preset:", 0) == 0)
+      importancePreset = o->tf.substr(7);
+    if (!importancePreset.empty()) {
+      const auto curve = TransferFunction::presetImportance(importancePreset);
+      if (curve.empty() && !o->importance.empty())
+        throw Error(ErrorKind::Usage, "--importance " + o->importance +
+                                          ": this preset carries no importance (the CT presets "
+                                          "ct-skin-bone and ct-bone do)");
+      if (!curve.empty()) engine.setImportanceCurve(curve, "preset:" + importancePreset);
+    } else if (!o->importance.empty()) {
+      engine.loadImportance(o->importance);
+    }
     LevelSetSettings ls = engine.levelSetSettings();
     if (o->lambda >= 0.f) ls.lambda = o->lambda;
     if (o->redistIterations >= 0) ls.redistanceIterations = o->redistIterations;
+    if (o->reach >= 0.f) ls.reach = o->reach;
     engine.setLevelSetSettings(ls);
+    if ((o->shell >= 0.f || o->filled) && !engine.contextSurfaces().empty()) {
+      // --shell and --filled apply to a scene's own context surfaces too.
+      std::vector<ContextSurfaceSpec> own = engine.contextSurfaces();
+      engine.clearContextSurfaces();
+      for (ContextSurfaceSpec spec : own) {
+        spec.filled = o->filled;
+        spec.shell = o->filled ? 0.f : o->shell;
+        engine.addContextSurface(spec);
+      }
+    }
     for (const auto& c : o->contexts) {
       ContextSurfaceSpec spec;
       spec.source = c;
-      spec.filled = o->shell < 0.f;
-      spec.shell = std::max(o->shell, 0.f);
+      if (o->filled) {
+        spec.filled = true;
+      } else if (o->shell >= 0.f) {
+        spec.filled = false;
+        spec.shell = o->shell;
+      } else {
+        spec = defaultContextSurfaceSpec(c, engine.volume().grid());
+      }
       engine.addContextSurface(spec);
     }
     if (!o->worldMask.empty()) engine.loadWorldMask(o->worldMask);

@@ -5,6 +5,8 @@
 
 #include <glm/glm.hpp>
 
+#include "visopt/grid.h"
+
 namespace visopt {
 
 // A context surface (paper 000 §III): opaque geometry held as an SDF on the volume's grid.
@@ -17,5 +19,14 @@ struct ContextSurfaceSpec {
   glm::vec3 color{0.87f, 0.72f, 0.6f};
   bool visible = true;
 };
+
+// The representation a source gets unless the user chooses: an isosurface of the data
+// ("iso:...") is a thin shell reaching one voxel (the grid's smallest spacing) each side, since
+// the isosurface of a scan bounds a tissue layer (skin, a vessel wall), not a solid: filled, a
+// skin hides everything inside the head, and Eq. 23 can open it at best down to a minimal
+// surface spanning the rim of what lies behind, so the far half of an important structure
+// inside stays hidden (README, "Context surfaces that give way"). Meshes and .vdb files stay
+// filled, as their authors closed them.
+ContextSurfaceSpec defaultContextSurfaceSpec(const std::string& source, const GridSpec& grid);
 
 }  // namespace visopt

@@ -11,9 +11,18 @@ struct LevelSetSettings {
   float lambda = 0.3f;
   float curvatureEpsilon = 1e-6f;  // in the curvature's denominator (METHODS.md §3)
   // Explicit Euler: each step uses cfl times the largest stable time step (METHODS.md §3),
-  // and `substeps` such steps run per optimisation iteration.
+  // and at least `substeps` such steps run per optimisation iteration.
   float cfl = 0.5f;
   int substeps = 4;
+  // How far surfaces can travel in one optimisation run. The curvature term moves a surface of
+  // radius R at speed ghat / R, and the stable step is ~dx^2 / 6, so a fixed number of substeps
+  // moves a head-sized surface by a fraction of a voxel per iteration: on a CT skin (R ~ 50
+  // coarse voxels) 60 iterations of 4 substeps dent it by ~0.4 voxel where it should give way
+  // by tens. With reach > 0 the optimiser runs, per iteration of the coarsest level, enough
+  // substeps that over its iteration cap mean-curvature flow at ghat = 1/2 could shrink a sphere
+  // of reach x the volume's bounding radius to a point (time reach^2 R^2 / 2); finer levels run
+  // (h_coarsest / h)^2 as many, i.e. polish what the coarse levels moved. 0: `substeps` only.
+  float reach = 1.f;
   // Redistancing (Eq. 18): at most this many iterations, stopping early when the mean squared
   // change per iteration falls below the tolerance (in voxel units squared).
   int redistanceIterations = 64;
@@ -25,10 +34,19 @@ struct LevelSetSettings {
   int spatialOrder = 2;
 };
 
+// Half-width, in voxels, of the band around the surface whose motion LevelSetStepStats reports
+// (|phi| within a voxel: where the zero level set lies; an opened region's positive phi keeps
+// rising under the curvature term without any surface moving).
+constexpr float kNearSurfaceBand = 1.f;
+
 struct LevelSetStepStats {
   double timeStep = 0.0;  // dt of one substep
   int substeps = 0;
-  double maxChange = 0.0;   // max |delta phi| of one substep, world units
+  double maxChange = 0.0;  // max |delta phi| of one substep, world units
+  // max |delta phi| of one substep over voxels within kNearSurfaceBand voxels of the surface:
+  // how far the surface itself moved (the far field's kinks move faster, and matter only when
+  // a surface comes near them).
+  double nearMaxChange = 0.0;
   double meanChange = 0.0;  // mean |delta phi| per substep
 };
 

@@ -52,8 +52,10 @@ struct IterationStats {
   double energy() const { return energyRho + energyQ + energyR; }
   double visibilityView = 0.0;   // V = ∫ g mu T_V / ∫ g mu over the view frustum
   double visibilityLight = 0.0;  // the same from the light (0 when r = 0)
-  // V with T_V taken through unimportant matter only: how much the occluders hide the important
-  // structures, leaving out their own fronts (the energy raises mu inside them, Eq. 12).
+  // Visibility through occluders: sum g mu T_V / sum g mu T_imp, T_imp the transmittance
+  // through important matter alone: how much unimportant matter and context surfaces hide the
+  // important structures, 1 when nothing does. What a structure hides of itself (its own front,
+  // the back of a skull behind its front) weighs ~0 in both sums (kernels/visibility_scan.h).
   double visibilityViewOccluders = 0.0;
   double stepNorm = 0.0;          // RMS of the change of mu over the voxels
   double gridUpdatesMs = 0.0;     // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
@@ -64,7 +66,9 @@ struct IterationStats {
   int redistanceIterations = 0;
   double redistanceResidual = 0.0;  // mean squared change of the last iteration (voxels^2)
   double levelSetTimeStep = 0.0;
-  double maxDeviationVoxels = 0.0;  // |phi0| on the current surface, over surface voxels
+  int levelSetSubsteps = 0;           // substeps of Eq. 23 this iteration
+  double levelSetMotionVoxels = 0.0;  // bound on how far phi moved this iteration, voxels
+  double maxDeviationVoxels = 0.0;    // |phi0| on the current surface, over surface voxels
   double meanDeviationVoxels = 0.0;
 };
 

@@ -61,6 +61,10 @@ class TransferFunction {
   // Built-in presets, in data units: "ct-skin-bone", "ct-bone", "mri", "generic".
   // "generic" spans [valueMin, valueMax] of the data and must be given that range.
   static std::vector<std::string> presetNames();
+  // The importance a preset is made to be used with, as a curve of (value, g) in data units:
+  // bone (g rising from 0 at 200 HU to 1 at 300 HU, where ct-skin-bone and ct-bone turn bone
+  // opaque) for the CT presets; empty for the others.
+  static std::vector<glm::dvec2> presetImportance(const std::string& name);
   static TransferFunction preset(const std::string& name, double valueMin = 0.0,
                                  double valueMax = 1.0);
 };

@@ -48,6 +48,16 @@ Field3D isoSurface(const std::string& spec, const Volume& volume, const LevelSet
 
 }  // namespace
 
+ContextSurfaceSpec defaultContextSurfaceSpec(const std::string& source, const GridSpec& grid) {
+  ContextSurfaceSpec spec;
+  spec.source = source;
+  if (startsWith(source, "iso:")) {
+    spec.filled = false;
+    spec.shell = grid.minSpacing();
+  }
+  return spec;
+}
+
 Field3D buildContextSurface(const ContextSurfaceSpec& spec, const Volume& volume,
                             const LevelSetSettings& levelSet, Precision precision,
                             MemoryLedger* ledger, const ProgressCallback& progress) {

@@ -215,19 +215,31 @@ VISOPT_HD VISOPT_INLINE float godunovSquared(const OneSided& d, bool positiveSpe
   return maxOf(a * a, b * b);
 }
 
-// Per-launch reduction of a step: largest and summed |delta phi|.
+// Per-launch reduction of a step: largest and summed |delta phi|, and the largest |delta phi|
+// among voxels within the kernel's nearBand of the surface (|phi| <= nearBand before the step):
+// how far the surface itself moved, which the far field's kinks (moving at up to ghat / dx)
+// do not inflate.
 struct ChangeSums {
   float maxAbs = 0.f;
   double sumAbs = 0.0;
   double sumSquared = 0.0;
+  float nearMaxAbs = 0.f;
+  double nearSumSquared = 0.0;  // sum of delta phi^2 over the voxels within nearBand
+  double nearCount = 0.0;       // how many voxels lie within nearBand
   VISOPT_HD ChangeSums operator+(const ChangeSums& o) const {
-    return {maxOf(maxAbs, o.maxAbs), sumAbs + o.sumAbs, sumSquared + o.sumSquared};
+    return {maxOf(maxAbs, o.maxAbs),           sumAbs + o.sumAbs,
+            sumSquared + o.sumSquared,         maxOf(nearMaxAbs, o.nearMaxAbs),
+            nearSumSquared + o.nearSumSquared, nearCount + o.nearCount};
   }
-  VISOPT_HD void add(float d) {
+  VISOPT_HD void add(float d, float before, float nearBand) {
     const float a = fabsf(d);
     maxAbs = maxOf(maxAbs, a);
     sumAbs += double(a);
     sumSquared += double(d) * double(d);
+    const bool near = fabsf(before) <= nearBand;
+    nearMaxAbs = maxOf(nearMaxAbs, near ? a : 0.f);
+    nearSumSquared += near ? double(d) * double(d) : 0.0;
+    nearCount += near ? 1.0 : 0.0;
   }
 };
 
@@ -250,7 +262,7 @@ VISOPT_HD ChangeSums sweepVoxel(const K& k, int64_t v) {
                             stencilAxis(l, k.dims.z, nx * ny, k.spacing.z));
   k.write(size_t(v), next);
   ChangeSums sums;
-  sums.add(k.kept(next) - c);
+  sums.add(k.kept(next) - c, c, k.nearBand);
   return sums;
 }
 
@@ -269,13 +281,15 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
     const float c = k.current(v);
     const float next = k.next(v, ax, ay, az);
     k.write(v, next);
-    sums.add(k.kept(next) - c);
+    sums.add(k.kept(next) - c, c, k.nearBand);
   };
   const int lo = nx < 2 ? nx : 2;
   const int hi = nx - 2 > lo ? nx - 2 : lo;
   for (int i = 0; i < lo; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
-  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes];
-  for (int l = 0; l < kLanes; ++l) maxAbs[l] = sumAbs[l] = sumSquared[l] = 0.f;
+  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
+      nearSumSquared[kLanes], nearCount[kLanes];
+  for (int l = 0; l < kLanes; ++l)
+    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] = 0.f;
   int i = lo;
   for (; i + kLanes <= hi; i += kLanes) {
     const size_t v0 = base + size_t(i);
@@ -288,6 +302,10 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
       maxAbs[l] = maxOf(maxAbs[l], fabsf(d));
       sumAbs[l] += fabsf(d);
       sumSquared[l] += d * d;
+      const bool near = fabsf(c) <= k.nearBand;
+      nearMaxAbs[l] = maxOf(nearMaxAbs[l], near ? fabsf(d) : 0.f);
+      nearSumSquared[l] += near ? d * d : 0.f;
+      nearCount[l] += near ? 1.f : 0.f;
     }
   }
   for (; i < hi; ++i) single(i, inner);
@@ -296,6 +314,9 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
     sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
     sums.sumAbs += double(sumAbs[l]);
     sums.sumSquared += double(sumSquared[l]);
+    sums.nearMaxAbs = maxOf(sums.nearMaxAbs, nearMaxAbs[l]);
+    sums.nearSumSquared += double(nearSumSquared[l]);
+    sums.nearCount += double(nearCount[l]);
   }
   return sums;
 }
@@ -318,7 +339,7 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
     const float c = k.current(v);
     const float next = k.nextAt(v, k.masked(v), stencilAxis(i, nx, 1, k.spacing.x), ay, az);
     k.write(v, next);
-    sums.add(k.kept(next) - c);
+    sums.add(k.kept(next) - c, c, k.nearBand);
   };
   const int lo = nx < 2 ? nx : 2;
   const int hi = nx - 2 > lo ? nx - 2 : lo;
@@ -328,8 +349,10 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
   }
   for (int i = 0; i < lo; ++i) single(i);
   const InnerAxis ax = innerAxis(1, k.spacing.x);
-  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes];
-  for (int l = 0; l < kLanes; ++l) maxAbs[l] = sumAbs[l] = sumSquared[l] = 0.f;
+  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
+      nearSumSquared[kLanes], nearCount[kLanes];
+  for (int l = 0; l < kLanes; ++l)
+    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] = 0.f;
   for (int done = lo; done < hi;) {
     const int i0 = done + kLanes <= hi ? done : hi - kLanes;
     const size_t v0 = base + size_t(i0);
@@ -346,6 +369,10 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
       maxAbs[l] = maxOf(maxAbs[l], fabsf(d));
       sumAbs[l] += fabsf(d);
       sumSquared[l] += d * d;
+      const bool near = fabsf(current[l]) <= k.nearBand && i0 + l >= done;
+      nearMaxAbs[l] = maxOf(nearMaxAbs[l], near ? fabsf(d) : 0.f);
+      nearSumSquared[l] += near ? d * d : 0.f;
+      nearCount[l] += near ? 1.f : 0.f;
     }
     done = i0 + kLanes;
   }
@@ -354,6 +381,9 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
     sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
     sums.sumAbs += double(sumAbs[l]);
     sums.sumSquared += double(sumSquared[l]);
+    sums.nearMaxAbs = maxOf(sums.nearMaxAbs, nearMaxAbs[l]);
+    sums.nearSumSquared += double(nearSumSquared[l]);
+    sums.nearCount += double(nearCount[l]);
   }
   return sums;
 }
@@ -382,6 +412,7 @@ struct LevelSetStepKernel {
   float lambda = 0.f;
   float curvatureEpsilon = 1e-6f;
   float kappaMax = 1.f;
+  float nearBand = 3.4e38f;  // ChangeSums::nearMaxAbs counts voxels with |phi| <= this
 
   VISOPT_HD VISOPT_INLINE float current(size_t v) const { return phi.load(v); }
   VISOPT_HD VISOPT_INLINE void write(size_t v, float x) const { out.store(v, x); }

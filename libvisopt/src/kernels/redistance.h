@@ -67,6 +67,7 @@ struct RedistanceKernel {
   A base{};
   bool hasBase = false;
   float keepWithin = 0.f;
+  float nearBand = 3.4e38f;  // ChangeSums::nearMaxAbs counts voxels with |phi| <= this
 
   VISOPT_HD VISOPT_INLINE float current(size_t v) const { return in.load(v); }
   VISOPT_HD VISOPT_INLINE void write(size_t v, float x) const { out.store(v, x); }

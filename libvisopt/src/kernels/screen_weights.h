@@ -24,8 +24,12 @@ struct ScreenWeights {
 
   // Weight of the ray through frustum pixel (i, j) of an nx x ny grid (j = 0 at the bottom).
   VISOPT_HD float at(int i, int j, int nx, int ny) const {
-    const float u = (float(i) + 0.5f) / float(nx);
-    const float v = 1.f - (float(j) + 0.5f) / float(ny);
+    return atPoint(float(i), float(j), nx, ny);
+  }
+  // The same at a continuous frustum position (x, y): pixel (i, j)'s centre is (i, j).
+  VISOPT_HD float atPoint(float x, float y, int nx, int ny) const {
+    const float u = (x + 0.5f) / float(nx);
+    const float v = 1.f - (y + 0.5f) / float(ny);
     float w = 1.f;
     if (mask.valid())
       w *=

@@ -149,7 +149,11 @@ struct ExtinctionOptimizer::Level {
   int shrink = 1;  // frustum grids are this many times coarser than at the finest level
   int t = 0;       // optimiser steps taken on this level
   float gradientScale = 1.f;
-  double motionSinceRedistance = 0.0;  // bound on |delta phi| since the last redistancing
+  double motionSinceRedistance = 0.0;  // bound on the surfaces' motion since the last redistancing
+  int substeps = 0;                    // level-set substeps per iteration (LevelSetSettings::reach)
+  double farMotionSinceRedistance = 0.0;  // the same over the whole grid
+  double lastMotion = 0.0;  // bound on how far the surfaces moved in the last iteration, world
+                            // units
   double lastEnergy = 0.0;
 };
 
@@ -261,6 +265,46 @@ void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
     }
     to.store(size_t(v), m);
   });
+}
+
+// Substeps of the level-set step per iteration on `level` (LevelSetSettings::reach).
+// The lens and windowing mask of the view rays (paper 000 §III-F, Fig. 8).
+ScreenWeights screenWeightsOf(const OptimizationInputs& in) {
+  ScreenWeights weights;
+  if (in.lens.radius > 0.f) {
+    weights.lensCentre = glm::vec2(in.lens.x, in.lens.y);
+    // The radius is a fraction of the image width; the weights work in [0,1]^2 per axis, so
+    // the circle is stretched back to round for non-square images by the aspect below.
+    weights.lensRadius = in.lens.radius;
+    weights.lensStrength = in.lens.strength;
+  }
+  if (in.screenMask) weights.mask = FieldView(*in.screenMask);
+  return weights;
+}
+
+// The joint loop's redistancing stops once the band within this many voxels of the surfaces has
+// settled (level_set.h: redistance).
+constexpr float kRedistanceStopBand = 3.f;
+
+int levelSetSubsteps(const OptimizationInputs& in, const ExtinctionSettings& s,
+                     const GridSpec& level, int cap) {
+  const LevelSetSettings& ls = in.levelSet;
+  const int least = std::max(ls.substeps, 1);
+  if (!(ls.reach > 0.f) || !std::isfinite(ls.reach)) return least;
+  // The time mean-curvature flow at ghat = 1/2 needs to shrink a sphere of radius
+  // reach x R to a point, r^2 = R^2 - 4 ghat t, spread over the coarsest level's iteration
+  // cap, in steps of the stable dt = cfl h^2 / 6 (ghat <= 1) of the coarsest grid.
+  const GridSpec& fine = in.volume->grid();
+  const GridSpec coarsest = levelGrid(fine, 1 << (std::max(s.levels, 1) - 1));
+  const double radius = double(ls.reach) * 0.5 * double(fine.diagonal());
+  const double h0 = coarsest.minSpacing(), h = level.minSpacing();
+  const double cfl = std::clamp(double(ls.cfl), 1e-3, 1.0);
+  const double time = radius * radius / 2.0;
+  const double dt0 = cfl * h0 * h0 / 6.0;
+  const double perIteration = time / dt0 / double(std::max(cap, 1));
+  // Finer levels: (h / h0)^2 as many substeps per iteration (each a (h / h0)^2 shorter step).
+  const double n = std::ceil(perIteration * (h / h0) * (h / h0));
+  return int(std::clamp(n, double(least), 4096.0));
 }
 
 float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s, Precision p) {
@@ -383,7 +427,11 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   L.view = FrustumGrid::forCamera(in.camera, w, h, bounds,
                                   s.depthCells > 0 ? std::max(2, s.depthCells / shrink) : 0,
                                   L.grid.minSpacing());
-  if (s.r != 0.f) {
+  // Light grids for the light term, and for the light half of ghat (Eq. 19) whenever there are
+  // context surfaces: a closed surface that gave way only towards the camera leaves what it
+  // revealed in its own shadow (T_L = 0 inside it), so it must give way towards the light too.
+  const bool lightGrids = s.r != 0.f || !L.phi.empty();
+  if (lightGrids) {
     const int n = std::max(4, s.lightGridSize / shrink);
     L.light = FrustumGrid::forLight(in.light, bounds, glm::ivec3(n, n, 0), L.grid.minSpacing());
   } else {
@@ -409,15 +457,7 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   SurfaceSet surfaces;
   for (size_t si = 0; si < L.phi.size() && si < size_t(kMaxContextSurfaces); ++si)
     surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
-  ScreenWeights weights;
-  if (in.lens.radius > 0.f) {
-    weights.lensCentre = glm::vec2(in.lens.x, in.lens.y);
-    // The radius is a fraction of the image width; the weights work in [0,1]^2 per axis, so
-    // the circle is stretched back to round for non-square images by the aspect below.
-    weights.lensRadius = in.lens.radius;
-    weights.lensStrength = in.lens.strength;
-  }
-  if (in.screenMask) weights.mask = FieldView(*in.screenMask);
+  const ScreenWeights weights = screenWeightsOf(in);
   auto t0 = Clock::now();
   ScanSums view, light;
   if (p.q != 0.f || hasSurfaces)
@@ -426,7 +466,7 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
                     hasSurfaces ? &L.viewMax : nullptr, "view-importance-behind");
   else
     L.dView.reset();
-  if (p.r != 0.f)
+  if (lightGrids)
     light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
                      "light-derivative", precision_, ledger_, surfaces, ScreenWeights{},
                      hasSurfaces ? &L.lightMax : nullptr, "light-importance-behind");
@@ -502,62 +542,104 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   st.energyQ = -double(p.q) * view.gMuT;
   st.energyR = -double(p.r) * light.gMuT;
   st.visibilityView = view.gMu > 0 ? view.gMuT / view.gMu : 0.0;
-  st.visibilityViewOccluders = view.gMu > 0 ? view.gMuTOccluders / view.gMu : 0.0;
+  st.visibilityViewOccluders = view.visibilityThroughOccluders();
   st.visibilityLight = light.gMu > 0 ? light.gMuT / light.gMu : 0.0;
   st.stepNorm = std::sqrt(sums.step2 / double(L.grid.voxelCount()));
-  if (hasSurfaces) surfaceStep(in, L, st);
+  if (hasSurfaces) {
+    L.substeps = levelSetSubsteps(in, s, L.grid, cap);
+    surfaceStep(in, L, st);
+  }
   return st;
 }
 
 void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, IterationStats& st) {
   // ghat (Eq. 19): half the max importance behind x along the view ray, half along the light
-  // ray; without the light term (r = 0, no light grids) the view ray alone.
+  // ray (the light grids exist whenever there are surfaces).
   auto t0 = Clock::now();
   const GridMap map(L.grid);
   FieldView ghat(*L.ghat);
   const FrustumMap view(L.view), light(L.light);
   const FieldView viewMax = L.viewMax ? FieldView(*L.viewMax) : FieldView();
   const FieldView lightMax = L.lightMax ? FieldView(*L.lightMax) : FieldView();
+  // The lens and windowing masks weigh the light half too, by the screen position of x: under
+  // a lens of strength 0 a surface keeps its shape, not opening towards the light either.
+  const ScreenWeights weights = screenWeightsOf(in);
   exec::parallelFor(
       "grid updates: importance behind", int64_t(L.grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
         const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
                   k = int(v / (int64_t(map.dims.x) * map.dims.y));
         const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
         const float vm = gatherFrustum(view, viewMax, x);
-        const float g =
-            lightMax.valid() ? 0.5f * vm + 0.5f * gatherFrustum(light, lightMax, x) : vm;
+        float g = vm;
+        if (lightMax.valid()) {
+          float lm = gatherFrustum(light, lightMax, x);
+          if (weights.active()) {
+            const glm::vec3 y = view.toGrid(x);
+            if (y.z >= -0.5f && y.z <= float(view.dims.z) - 0.5f)
+              lm = fminf(lm * weights.atPoint(y.x, y.y, view.dims.x, view.dims.y), 1.f);
+          }
+          g = 0.5f * vm + 0.5f * lm;
+        }
         ghat.store(size_t(v), fminf(fmaxf(g, 0.f), 1.f));
       });
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
-  LevelSetStepStats ls;
-  for (size_t si = 0; si < L.phi.size(); ++si) {
-    const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
-    ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, in.levelSet, *L.scratch);
-    L.motionSinceRedistance =
-        std::max(L.motionSinceRedistance, ls.maxChange * double(std::max(ls.substeps, 1)));
-  }
   st.sdfStepMs = msSince(t0);
-  st.levelSetTimeStep = ls.timeStep;
-
-  // Redistancing (Eq. 18) runs once the steps since the last one may have moved phi by half a
-  // voxel somewhere. Each redistancing moves the zero level set by a small O(h) amount of its
-  // own (the subcell estimate next to the interface); run after every tiny step it would undo
-  // slow surface motion, which is what happened with a thin shell whose medial kink lies a
-  // voxel from the surface.
-  auto t1 = Clock::now();
-  if (L.motionSinceRedistance >= 0.5 * double(L.grid.minSpacing())) {
+  // The level-set substeps run in chunks; redistancing (Eq. 18) runs once the steps since the
+  // last one may have moved phi by half a voxel somewhere, so |grad phi| stays near 1 while a
+  // surface travels several voxels in one iteration. Each redistancing moves the zero level set
+  // by a small O(h) amount of its own (the subcell estimate next to the interface); run after
+  // every tiny step it would undo slow surface motion, which is what happened with a thin shell
+  // whose medial kink lies a voxel from the surface.
+  const double h = double(L.grid.minSpacing());
+  LevelSetSettings chunkSettings = in.levelSet;
+  const int chunk = std::max(in.levelSet.substeps, 1);
+  LevelSetStepStats ls;
+  L.lastMotion = 0.0;
+  for (int done = 0; done < std::max(L.substeps, 1); done += chunk) {
+    chunkSettings.substeps = std::min(chunk, std::max(L.substeps, 1) - done);
+    auto ts = Clock::now();
+    double motion = 0.0, farMotion = 0.0;
+    bool anySurface = false;
     for (size_t si = 0; si < L.phi.size(); ++si) {
       const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
-      RedistanceStats rs = redistance(L.phi[si], in.levelSet, *L.scratch, &phi0);
-      st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
-      st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
+      ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, chunkSettings, *L.scratch);
+      const double n = double(std::max(ls.substeps, 1));
+      motion = std::max(motion, ls.nearMaxChange * n);
+      farMotion = std::max(farMotion, ls.maxChange * n);
+      anySurface = anySurface || hasInterface(L.phi[si]);
     }
-    L.motionSinceRedistance = 0.0;
+    L.motionSinceRedistance += motion;
+    L.farMotionSinceRedistance += farMotion;
+    L.lastMotion += motion;
+    st.sdfStepMs += msSince(ts);
+    auto t1 = Clock::now();
+    // Also once the far field may have drifted by two voxels: its kinks (the medial axis,
+    // where the clamped curvature moves phi by up to ghat / dx) must not rise through zero more
+    // than kNearSurfaceBand voxels away from the surface.
+    if (L.motionSinceRedistance >= 0.5 * h || L.farMotionSinceRedistance >= 2.0 * h) {
+      for (size_t si = 0; si < L.phi.size(); ++si) {
+        const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
+        RedistanceStats rs =
+            redistance(L.phi[si], in.levelSet, *L.scratch, &phi0, kRedistanceStopBand);
+        st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
+        st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
+      }
+      L.motionSinceRedistance = 0.0;
+      L.farMotionSinceRedistance = 0.0;
+    }
+    st.redistanceMs += msSince(t1);
+    // Every surface has vanished (ghat >= lambda all over it): there is nothing left to move,
+    // and more substeps would only raise phi without bound where no redistancing can reach
+    // (there is no interface to measure distance from). The next iteration tries again, so a
+    // surface that the return term brings back carries on.
+    if (!anySurface) break;
   }
-  st.redistanceMs = msSince(t1);
+  st.levelSetTimeStep = ls.timeStep;
+  st.levelSetSubsteps = std::max(L.substeps, 1);
+  st.levelSetMotionVoxels = L.lastMotion / h;
 
   // Deviation of the current surfaces from their base, over voxels on the current surface.
-  const float h = L.grid.minSpacing();
+  const float hf = float(h);
   for (size_t si = 0; si < L.phi.size(); ++si) {
     const FieldView phi(L.phi[si]);
     const FieldView base(L.finest ? *in.surfaceBases[si] : L.phi0[si]);
@@ -565,10 +647,10 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
         "surface deviation", int64_t(L.grid.voxelCount()), DeviationSums{},
         [=] VISOPT_HD(int64_t v) {
           DeviationSums r;
-          if (fabsf(phi.load(size_t(v))) <= 0.5f * h) {
+          if (fabsf(phi.load(size_t(v))) <= 0.5f * hf) {
             // phi0 - phi at a voxel next to the current surface is phi0 at (about) the
             // nearest surface point: how far the surface has moved from its base there.
-            const double dev = fabsf(base.load(size_t(v)) - phi.load(size_t(v))) / h;
+            const double dev = fabsf(base.load(size_t(v)) - phi.load(size_t(v))) / hf;
             r.sum = dev;
             r.max = dev;
             r.count = 1;
@@ -619,7 +701,11 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
       const double e = st.energy();
       const double rel = std::abs(e - last) / std::max(std::abs(e), 1e-30);
       last = e;
-      if (it + 1 >= s.minIterationsPerLevel && rel < s.tolerance) break;
+      // A level ends when the energy has settled and the surfaces have: moving by less than a
+      // tenth of a voxel in the last iteration (the energy alone can stall while a surface is
+      // still on its way through an unimportant layer).
+      const bool surfacesSettled = st.levelSetMotionVoxels < 0.1;
+      if (it + 1 >= s.minIterationsPerLevel && rel < s.tolerance && surfacesSettled) break;
     }
   }
   return all;

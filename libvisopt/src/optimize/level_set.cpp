@@ -124,6 +124,7 @@ ChangeSums substepWith(const Field3D& phi, const Field3D& phi0, const Field3D& g
   k.lambda = s.lambda;
   k.curvatureEpsilon = s.curvatureEpsilon;
   k.kappaMax = 1.f / g.minSpacing();
+  k.nearBand = kNearSurfaceBand * g.minSpacing();
   return launchStencil<ChangeSums>("level set: step", k, g.dims);
 }
 
@@ -137,7 +138,8 @@ ChangeSums substep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
 }
 
 template <class A, int Order>
-double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, const Field3D* base) {
+double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, const Field3D* base,
+                          float stopBand) {
   const GridSpec& g = in.grid();
   RedistanceKernel<A, Order> k;
   k.in = accessOf(in, Tag<A>{});
@@ -152,16 +154,19 @@ double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, cons
   k.dxMin = g.minSpacing();
   k.dtau = (Order == 2 ? 0.3f : 0.5f) * k.dxMin;
   k.initialise = initialise;
+  if (stopBand > 0.f) k.nearBand = stopBand * k.dxMin;
   const ChangeSums c = launchStencil<ChangeSums>("level set: redistance", k, g.dims);
+  if (stopBand > 0.f)
+    return c.nearCount > 0.0 ? c.nearSumSquared / (double(k.dxMin) * k.dxMin) / c.nearCount : 0.0;
   return c.sumSquared / (double(k.dxMin) * k.dxMin) / double(in.size());
 }
 
 double redistancePass(const Field3D& in, Field3D& out, bool initialise, int order,
-                      const Field3D* base = nullptr) {
+                      const Field3D* base = nullptr, float stopBand = 0.f) {
   auto run = [&](auto tag) {
     using A = typename decltype(tag)::type;
-    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base)
-                      : redistancePassWith<A, 2>(in, out, initialise, base);
+    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base, stopBand)
+                      : redistancePassWith<A, 2>(in, out, initialise, base, stopBand);
   };
   return base ? dispatch({&in, &out, base}, run) : dispatch({&in, &out}, run);
 }
@@ -212,6 +217,7 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   for (int n = 0; n < s.substeps; ++n) {
     const ChangeSums c = substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to);
     stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
+    stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
     stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
     std::swap(from, to);
   }
@@ -226,8 +232,13 @@ double redistanceIteration(const Field3D& in, Field3D& out, int spatialOrder) {
   return redistancePass(in, out, false, spatialOrder);
 }
 
+bool hasInterface(const Field3D& phi) {
+  return exec::reduce("level set: interface", int64_t(phi.size()), int64_t(0),
+                      InterfaceCount{FieldView(phi)}, Plus{}) > 0;
+}
+
 RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
-                           const Field3D* base) {
+                           const Field3D* base, float stopBand) {
   requireSameGrid(phi, phi, "phi");
   if (base) requireSameGrid(phi, *base, "the base SDF");
   checkOrder(s);
@@ -243,7 +254,8 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
   Field3D* to = &scratch;
   for (int n = 0; n < s.redistanceIterations; ++n) {
     // The first pass also sets the interface band to its subcell distance (kept afterwards).
-    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder, base);
+    stats.meanSquaredChange =
+        redistancePass(*from, *to, n == 0, s.spatialOrder, base, std::max(stopBand, 0.f));
     stats.iterations = n + 1;
     std::swap(from, to);
     if (stats.meanSquaredChange < double(s.redistanceTolerance)) {

@@ -33,9 +33,16 @@ double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s);
 // from: it is left unchanged (0 iterations, converged). With `base` (the surface's phi0, on
 // phi's grid) every voxel within kRedistanceKeepsBaseWithin voxels of phi0 keeps its value:
 // only where the surface moved is it redistanced, and elsewhere it stays exactly in place.
+// True when phi changes sign between two neighbouring voxels somewhere (it has a surface).
+bool hasInterface(const Field3D& phi);
+
+// With stopBand > 0 the early stop measures the mean squared change over the voxels within
+// stopBand voxels of the surface only (|phi| <= stopBand dx before the pass), where the joint
+// loop needs the distance: over the whole box, regions far from every surface that are still
+// converging (a region a surface left) hold every call to its iteration cap.
 inline constexpr float kRedistanceKeepsBaseWithin = 0.05f;
 RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
-                           const Field3D* base = nullptr);
+                           const Field3D* base = nullptr, float stopBand = 0.f);
 
 // Single passes, for the benchmark: one Euler substep of Eq. 23 with a given dt from `phi`
 // into `out` (returns max |delta phi|), and one redistancing iteration from `in` into `out`

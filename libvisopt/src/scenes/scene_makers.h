@@ -10,6 +10,7 @@ BuiltinScene makeMarschnerLobb(int resolution, Precision precision, MemoryLedger
 BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeHydrogen(int resolution, Precision precision, MemoryLedger* ledger);
+BuiltinScene makeCtHead(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger* ledger);
 
 }  // namespace visopt::scenes

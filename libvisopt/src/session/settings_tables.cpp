@@ -34,6 +34,7 @@ const FieldTable<LevelSetSettings>& levelSetFields() {
                                 .add("curvatureEpsilon", &S::curvatureEpsilon)
                                 .add("cfl", &S::cfl)
                                 .add("substeps", &S::substeps)
+                                .add("reach", &S::reach)
                                 .add("redistanceIterations", &S::redistanceIterations)
                                 .add("redistanceTolerance", &S::redistanceTolerance)
                                 .add("spatialOrder", &S::spatialOrder);

@@ -113,6 +113,13 @@ std::vector<std::string> TransferFunction::presetNames() {
   return names;
 }
 
+std::vector<glm::dvec2> TransferFunction::presetImportance(const std::string& name) {
+  (void)tfpresets::compiledIn(name);  // rejects unknown names
+  if (name == "ct-skin-bone" || name == "ct-bone")
+    return {{-1024.0, 0.0}, {200.0, 0.0}, {300.0, 1.0}, {3071.0, 1.0}};
+  return {};
+}
+
 TransferFunction TransferFunction::preset(const std::string& name, double valueMin,
                                           double valueMax) {
   TransferFunction tf = tfpresets::compiledIn(name);  // also rejects unknown names

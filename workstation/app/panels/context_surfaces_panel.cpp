@@ -186,8 +186,10 @@ AddSurfaceDialog::AddSurfaceDialog(QWidget* parent) : QDialog(parent) {
   filled_->setToolTip(tr("The surface encloses a solid body."));
   shell_ = new QRadioButton(tr("Thin shell"), this);
   shell_->setObjectName(QStringLiteral("shell"));
-  shell_->setToolTip(tr("Only a shell of the given thickness each side of the surface is solid."));
-  filled_->setChecked(true);
+  shell_->setToolTip(
+      tr("Only a shell of the given thickness each side of the surface is solid (the default for "
+         "an isosurface: a scan's skin is a layer, and a filled skin hides all that it holds)."));
+  shell_->setChecked(true);  // the default for an isosurface (defaultContextSurfaceSpec)
   auto* repRow = new QHBoxLayout;
   repRow->addWidget(filled_);
   repRow->addWidget(shell_);
@@ -222,7 +224,14 @@ AddSurfaceDialog::AddSurfaceDialog(QWidget* parent) : QDialog(parent) {
     if (isValid()) accept();
   });
   connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
-  connect(kind_, &QComboBox::currentIndexChanged, this, &AddSurfaceDialog::updateState);
+  connect(kind_, &QComboBox::currentIndexChanged, this, [this] {
+    // Each source's default representation: an isosurface of a scan bounds a layer (a thin
+    // shell), a mesh or .vdb file a closed body (filled).
+    const bool iso =
+        kind_->currentData().toInt() == static_cast<int>(SurfaceSourceFields::Kind::Iso);
+    (iso ? shell_ : filled_)->setChecked(true);
+    updateState();
+  });
   connect(file_, &QLineEdit::textChanged, this, &AddSurfaceDialog::updateState);
   connect(shell_, &QRadioButton::toggled, this, &AddSurfaceDialog::updateState);
   connect(thickness_, &QDoubleSpinBox::valueChanged, this, &AddSurfaceDialog::updateState);

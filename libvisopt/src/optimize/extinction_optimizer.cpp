@@ -592,13 +592,16 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   // whose medial kink lies a voxel from the surface.
   const double h = double(L.grid.minSpacing());
   LevelSetSettings chunkSettings = in.levelSet;
-  const int chunk = std::max(in.levelSet.substeps, 1);
+  // A chunk is as many substeps as keep the surface's motion under half a voxel at the rate of
+  // the last chunk (at least `substeps`, at most 64), so redistancing runs about once per half
+  // voxel moved rather than after every few substeps of a slow surface.
+  int chunk = std::max(in.levelSet.substeps, 1);
   LevelSetStepStats ls;
   L.lastMotion = 0.0;
-  for (int done = 0; done < std::max(L.substeps, 1); done += chunk) {
+  for (int done = 0; done < std::max(L.substeps, 1); done += chunkSettings.substeps) {
     chunkSettings.substeps = std::min(chunk, std::max(L.substeps, 1) - done);
     auto ts = Clock::now();
-    double motion = 0.0, farMotion = 0.0;
+    double motion = 0.0, farMotion = 0.0, rate = 0.0;
     bool anySurface = false;
     for (size_t si = 0; si < L.phi.size(); ++si) {
       const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
@@ -606,6 +609,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
       const double n = double(std::max(ls.substeps, 1));
       motion = std::max(motion, ls.nearMaxChange * n);
       farMotion = std::max(farMotion, ls.maxChange * n);
+      rate = std::max(rate, ls.nearMaxChange);
       anySurface = anySurface || hasInterface(L.phi[si]);
     }
     L.motionSinceRedistance += motion;
@@ -633,6 +637,8 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     // (there is no interface to measure distance from). The next iteration tries again, so a
     // surface that the return term brings back carries on.
     if (!anySurface) break;
+    const double fits = rate > 0.0 ? 0.5 * h / rate : 64.0;
+    chunk = int(std::clamp(std::floor(fits), double(std::max(in.levelSet.substeps, 1)), 64.0));
   }
   st.levelSetTimeStep = ls.timeStep;
   st.levelSetSubsteps = std::max(L.substeps, 1);

@@ -197,10 +197,36 @@ for tool in apt-get dpkg-deb tar sha256sum python3; do
   command -v $tool >/dev/null || { echo "fetch_datasets.sh: needs $tool" >&2; exit 1; }
 done
 
+# The brainsmall head stood upright (a direction matrix on the same voxels: index x runs face to
+# back, y top to bottom, z side to side) and its brain mask, the importance of docs/real-scans.md.
+brain_extras() {
+  [ -f "$DEST/brainsmall.raw" ] || return
+  ln -sf brainsmall.raw "$DEST/brainsmall-upright.raw"
+  python3 - "$DEST/brainsmall.raw.json" "$DEST/brainsmall-upright.raw.json" <<'PY' || return
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["direction"] = [0, 0, 1, -1, 0, 0, 0, -1, 0]
+json.dump(m, open(sys.argv[2], "w"))
+PY
+  if [ ! -s "$DEST/brainsmall-brain.raw" ]; then
+    python3 "$SCRIPT_DIR/brain_mask.py" "$DEST/brainsmall.raw" "$DEST/brainsmall.raw.json" \
+      "$DEST/brainsmall-brain.raw" >/dev/null || { say brain-mask "failed"; return; }
+  fi
+  ln -sf brainsmall-brain.raw "$DEST/brainsmall-brain-upright.raw"
+  python3 - "$DEST/brainsmall-brain.raw.json" "$DEST/brainsmall-brain-upright.raw.json" <<'PY' || return
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["direction"] = [0, 0, 1, -1, 0, 0, 0, -1, 0]
+json.dump(m, open(sys.argv[2], "w"))
+PY
+  say brain-mask "ok"
+}
+
 cranium
 skull
 meshes
 brainsmall
+brain_extras
 water
 
 [ $mismatch = 0 ] || exit 2

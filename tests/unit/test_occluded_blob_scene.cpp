@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.h"
 #include "visopt/engine.h"
 #include "visopt/scenes.h"
 
@@ -114,35 +115,15 @@ TEST(OccludedBlobScene, TheDiscBecomesVisibleAndTheRestOfTheWallStays) {
 }
 
 namespace {
-
-struct CliResult {
-  int code = -1;
-  std::string out, err;
-};
-
-CliResult runCli(const std::string& args) {
-  const std::filesystem::path dir = std::filesystem::path(VISOPT_TEST_TMP) / "occluded-blob";
-  std::filesystem::create_directories(dir);
-  const std::string errFile = (dir / ("stderr-" + std::to_string(getpid()) + ".txt")).string();
-  const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
-  CliResult r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream err(errFile);
-  r.err.assign(std::istreambuf_iterator<char>(err), {});
-  return r;
+visopt::testing::CliResult runCli(const std::string& args) {
+  return visopt::testing::runCli(args, "occluded-blob");
 }
-
 }  // namespace
 
 TEST(OccludedBlobScene, CliOptimizeShowsTheDiscComingIntoView) {
-  const CliResult r = runCli("optimize --scene builtin:occluded-blob --resolution " +
-                             std::to_string(kResolution) + " --size 96x96 --json");
+  const visopt::testing::CliResult r =
+      runCli("optimize --scene builtin:occluded-blob --resolution " + std::to_string(kResolution) +
+             " --size 96x96 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_GT(j["iterations"].size(), 10u);

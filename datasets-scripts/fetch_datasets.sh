@@ -13,6 +13,9 @@
 #   DEST/nAChR_M2_water.plt               gOpenMol plt float32 46x46x78 (native reader)
 #   DEST/water.raw + .raw.json            the same bytes as raw + sidecar (headerBytes 44)
 #   DEST/meshes/{bunny00,armadillo,head}.off
+#   DEST/colin27.nii.gz                   MRI head with scalp (Colin27, MRIcron's ch2), NIfTI
+#                                         uint8 181x217x181, 1 mm (native reader, RAS world)
+#   DEST/colin27-brain.raw + .raw.json    its brain (ch2bet > 0) as a 0/1 importance volume
 # Idempotent: files already present with the right checksum are kept; the downloaded .deb
 # files are cached in DEST/.cache/debs. Prints one line per dataset. Exit status: 0 when every
 # dataset it could get is fine (missing ones are reported, not fatal), 2 on a checksum mismatch.
@@ -193,6 +196,27 @@ water() {
   say water "ok"
 }
 
+# ---------------------------------------------------------------- Colin27 (mricron-data)
+# The hold-out scan of docs/real-scans.md: run with the brainsmall MRI's command, never tuned on.
+CH2_SHA=a009051127f64dc3dd554d5f5b589870ea72106d9642c21b4e7093e478cfc309
+CH2BET_SHA=592a2d20abdf36eefcb540ca8958428040edffc1bc1a18ba1dcfbabac77c5dd1
+colin() {
+  if sha_ok "$DEST/colin27.nii.gz" $CH2_SHA && [ -s "$DEST/colin27-brain.raw" ] \
+     && [ -s "$DEST/colin27-brain.raw.json" ]; then
+    say colin27 "ok (already present)"; return; fi
+  local d t=usr/share/mricron/templates
+  d=$(deb mricron-data 1.2.20211006+dfsg-4) || { say colin27 "failed: cannot download mricron-data"; return; }
+  member "$d" $t/ch2.nii.gz "$WORK/ch2.nii.gz" && member "$d" $t/ch2bet.nii.gz "$WORK/ch2bet.nii.gz" \
+    || { say colin27 "failed: ch2.nii.gz or ch2bet.nii.gz not found"; return; }
+  sha_ok "$WORK/ch2bet.nii.gz" $CH2BET_SHA \
+    || { say colin27 "failed: checksum mismatch of ch2bet.nii.gz"; mismatch=1; return; }
+  python3 "$SCRIPT_DIR/dataset_tools.py" nifti-mask "$WORK/ch2bet.nii.gz" "$WORK/colin27-brain.raw" \
+    || { say colin27 "failed: cannot convert ch2bet.nii.gz"; return; }
+  install_verified colin27 "$WORK/ch2.nii.gz" "$DEST/colin27.nii.gz" $CH2_SHA || return
+  mv "$WORK/colin27-brain.raw.json" "$DEST/" && mv "$WORK/colin27-brain.raw" "$DEST/" || return
+  say colin27 "ok"
+}
+
 for tool in apt-get dpkg-deb tar sha256sum python3; do
   command -v $tool >/dev/null || { echo "fetch_datasets.sh: needs $tool" >&2; exit 1; }
 done
@@ -228,6 +252,7 @@ meshes
 brainsmall
 brain_extras
 water
+colin
 
 [ $mismatch = 0 ] || exit 2
 exit 0

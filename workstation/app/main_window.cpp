@@ -213,6 +213,8 @@ void MainWindow::buildDocks() {
             setModified();
           });
   connect(tfEditor_, &TransferFunctionEditor::errorOccurred, this, &MainWindow::showError);
+  connect(tfEditor_, &TransferFunctionEditor::builtinPresetApplied, this,
+          &MainWindow::onBuiltinPresetApplied);
   tfEditor_->setInteractive(false);  // errors come here, shown as this window's dialogs
   connect(importanceEditor_, &ImportanceEditor::importanceCurveEdited, this,
           [this](const std::vector<glm::dvec2>& curve) {
@@ -406,6 +408,12 @@ void MainWindow::buildMenus() {
   opt->addAction(actLookElsewhere_);
   opt->addAction(tr("Restart from the transfer function"), this,
                  [this] { controller_->restartOptimization(); });
+  opt->addSeparator();
+  QAction* skinBone = opt->addAction(tr("CT: skin as context, bone as importance"), this,
+                                     &MainWindow::useSkinAsContextBoneAsImportance);
+  skinBone->setToolTip(
+      tr("The ct-skin-bone transfer function, bone (200-300 HU and above) as importance and the "
+         "skin isosurface at -400 HU as a thin-shell context surface, then optimise"));
 }
 
 void MainWindow::buildToolBar() {

@@ -64,6 +64,11 @@ class MainWindow : public QMainWindow {
   bool offerRecovery();
 
   void setOptimizationRunning(bool running);
+  // "Skin as context, bone as importance" in one step (main_window_presets.cpp): the
+  // ct-skin-bone transfer function, its bone importance, the skin isosurface as a thin-shell
+  // context surface (added once), and the optimisation running. An error (dialog) instead when
+  // the volume's values are not Hounsfield units.
+  void useSkinAsContextBoneAsImportance();
   // Renders the comparison baselines beside ours for the current view into the Comparison dock.
   void compareMethods();
   ComparisonView* comparisonView() const { return comparisonView_; }
@@ -124,6 +129,11 @@ class MainWindow : public QMainWindow {
   void chooseTool(QAction* action);
   bool maybeSave();
   void rebuildEngine(Precision precision);
+  // A built-in transfer-function preset was chosen: when the scene has no importance yet, the
+  // one the preset is made for (bone for the CT presets) becomes it.
+  void onBuiltinPresetApplied(const QString& name);
+  // Sets an importance curve in the engine and the importance editor alike.
+  void applyImportanceCurve(const std::vector<glm::dvec2>& curve, const std::string& origin);
 
   // UI-side state (the worker has its own copy).
   RenderSettings render_;

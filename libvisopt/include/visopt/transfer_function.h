@@ -7,6 +7,7 @@
 // 1 - 1e-4 so an opacity of 1 gives a large but finite extinction.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,10 @@ class TransferFunction {
   // bone (g rising from 0 at 200 HU to 1 at 300 HU, where ct-skin-bone and ct-bone turn bone
   // opaque) for the CT presets; empty for the others.
   static std::vector<glm::dvec2> presetImportance(const std::string& name);
+  // The isovalue of the surface a preset shows as context, in data units: the skin at -400 HU
+  // (inside ct-skin-bone's -500..-150 HU skin layer) for ct-skin-bone; none for the others.
+  // With presetImportance it makes "skin as context, bone as importance" one step.
+  static std::optional<double> presetContextIsovalue(const std::string& name);
   static TransferFunction preset(const std::string& name, double valueMin = 0.0,
                                  double valueMax = 1.0);
 };

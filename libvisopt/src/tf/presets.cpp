@@ -120,6 +120,12 @@ std::vector<glm::dvec2> TransferFunction::presetImportance(const std::string& na
   return {};
 }
 
+std::optional<double> TransferFunction::presetContextIsovalue(const std::string& name) {
+  (void)tfpresets::compiledIn(name);  // rejects unknown names
+  if (name == "ct-skin-bone") return -400.0;
+  return std::nullopt;
+}
+
 TransferFunction TransferFunction::preset(const std::string& name, double valueMin,
                                           double valueMax) {
   TransferFunction tf = tfpresets::compiledIn(name);  // also rejects unknown names

@@ -231,6 +231,7 @@ bool TransferFunctionEditor::applyPreset(int index) {
   }
   presetCombo_->setCurrentIndex(index);
   scheduleEdit();
+  if (kind == kBuiltin) emit builtinPresetApplied(key);
   return true;
 }
 

@@ -83,6 +83,8 @@ class TransferFunctionEditor : public QWidget {
 
  signals:
   void transferFunctionEdited(const visopt::TransferFunction& tf);
+  // A built-in preset (TransferFunction::presetNames) was applied; emitted after the edit.
+  void builtinPresetApplied(const QString& name);
   void errorOccurred(const QString& message);
 
  private:

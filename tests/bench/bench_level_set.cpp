@@ -11,9 +11,11 @@
 #include <benchmark/benchmark.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/LevelSetFilter.h>
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/LevelSetTracker.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -112,6 +114,48 @@ void BM_OpenVdbRenormalize(benchmark::State& state) {
   setCounters(state, double(grid->activeVoxelCount()));
 }
 
+// The band path as the optimiser runs it, per iteration: one level-set substep (Eq. 23) and one
+// redistancing iteration (Eq. 18), each over the active bricks of a band of half-width
+// range(2) voxels (LevelSetSettings::band), the band rebuilt by each call (a read pass over phi
+// and phi0 of the whole grid: the storage is still dense). ns_per_voxel divides by the band's
+// voxels (bricks of 8^3 within the half-width of the surface, so more than OpenVDB's band of
+// the same half-width).
+void BM_BandStepRedist(benchmark::State& state) {
+  const int n = int(state.range(0));
+  DenseSetup d(n, precisionOf(state.range(1)));
+  visopt::LevelSetSettings s;
+  s.band = float(state.range(2));
+  s.substeps = 1;
+  s.redistanceIterations = 1;
+  visopt::Field3D scratch;
+  int64_t bandVoxels = 0;
+  for (auto _ : state) {
+    const visopt::LevelSetStepStats st =
+        visopt::levelSetStep(d.phi, d.phi0, d.ghat, nullptr, s, scratch);
+    const visopt::RedistanceStats rs = visopt::redistance(d.phi, s, scratch, &d.phi0);
+    bandVoxels = std::max(st.bandVoxels, rs.bandVoxels);
+    benchmark::DoNotOptimize(rs.meanSquaredChange);
+  }
+  setCounters(state, double(bandVoxels > 0 ? bandVoxels : int64_t(d.phi.size())));
+}
+
+// OpenVDB's counterpart of BM_BandStepRedist: LevelSetFilter::meanCurvature(), one explicit
+// step of mean-curvature flow followed by the tracker's renormalisation (one iteration,
+// FIRST_BIAS + TVD_RK1) and band rebuild, on the same sphere with a band of half-width 3.
+void BM_OpenVdbCurvatureStep(benchmark::State& state) {
+  openvdb::initialize();
+  const int n = int(state.range(0));
+  const float c = 0.5f * float(n - 1);
+  auto grid = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+      0.25f * float(n), openvdb::Vec3f(c, c, c), 1.f, 3.f);
+  openvdb::tools::LevelSetFilter<openvdb::FloatGrid> filter(*grid);
+  filter.setSpatialScheme(openvdb::math::FIRST_BIAS);
+  filter.setTemporalScheme(openvdb::math::TVD_RK1);
+  filter.setNormCount(1);
+  for (auto _ : state) filter.meanCurvature();
+  setCounters(state, double(grid->activeVoxelCount()));
+}
+
 void denseArgs(benchmark::internal::Benchmark* b) {
   for (int n : {64, 128, 256})
     for (int p : {32, 16}) b->Args({n, p});
@@ -134,6 +178,22 @@ BENCHMARK(BM_SdfOpt)
 BENCHMARK(BM_Redist)
     ->Apply(redistArgs)
     ->ArgNames({"n", "fp", "order"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+void bandArgs(benchmark::internal::Benchmark* b) {
+  for (int n : {128, 256})
+    for (int p : {32, 16})
+      for (int halfWidth : {3, 8}) b->Args({n, p, halfWidth});
+}
+BENCHMARK(BM_BandStepRedist)
+    ->Apply(bandArgs)
+    ->ArgNames({"n", "fp", "band"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_OpenVdbCurvatureStep)
+    ->Arg(128)
+    ->Arg(256)
+    ->ArgNames({"n"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_OpenVdbRenormalize)

@@ -65,6 +65,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     float shell = -1.f, lambda = -1.f;
     int redistIterations = -1;
     float reach = -1.f;
+    float band = -1.f;
     bool filled = false, deviationView = false;
     int resolution = 128, levels = 3, iterations = 60;
     float rho = -1.f, q = 40.f, r = 0.f, lr = 0.05f, muMax = 0.f, frustumScale = 0.5f,
@@ -111,6 +112,9 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--level-set-reach", o->reach,
                  "How far surfaces can travel per run, in bounding radii (default 1; 0: a fixed "
                  "number of level-set substeps per iteration)");
+  app.add_option("--level-set-band", o->band,
+                 "Half-width in voxels of the narrow band the level-set step and redistancing run "
+                 "in (default 6; 0: the whole grid, the dense reference path)");
   app.add_option("--redist-iterations", o->redistIterations,
                  "Redistancing iterations at most (Eq. 18)");
   app.add_option("--world-mask", o->worldMask,
@@ -171,6 +175,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     if (o->lambda >= 0.f) ls.lambda = o->lambda;
     if (o->redistIterations >= 0) ls.redistanceIterations = o->redistIterations;
     if (o->reach >= 0.f) ls.reach = o->reach;
+    if (o->band >= 0.f) ls.band = o->band;
     engine.setLevelSetSettings(ls);
     if ((o->shell >= 0.f || o->filled) && !engine.contextSurfaces().empty()) {
       // --shell and --filled apply to a scene's own context surfaces too.

@@ -252,6 +252,18 @@ struct ChangeSums {
 // runs in chunks of kLanes with a fixed x stencil and per-lane accumulators, so that the
 // compiler can vectorise it.
 
+// The first voxel of span [x0, x1) at least two voxels from the row's start, and the end of the
+// voxels at least two from the row's end (never before `lo`).
+VISOPT_HD VISOPT_INLINE int spanInteriorBegin(int x0, int x1, int nx) {
+  const int start = nx < 2 ? nx : 2;
+  const int lo = x0 > start ? x0 : start;
+  return lo < x1 ? lo : x1;
+}
+VISOPT_HD VISOPT_INLINE int spanInteriorEnd(int x1, int nx, int lo) {
+  const int hi = x1 < nx - 2 ? x1 : nx - 2;
+  return hi > lo ? hi : lo;
+}
+
 template <class K>
 VISOPT_HD ChangeSums sweepVoxel(const K& k, int64_t v) {
   const int64_t nx = k.dims.x, ny = k.dims.y;
@@ -267,9 +279,10 @@ VISOPT_HD ChangeSums sweepVoxel(const K& k, int64_t v) {
 }
 
 template <class K>
-VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
+VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r, int x0 = 0, int x1 = -1) {
   constexpr int kLanes = 16;
   const int nx = k.dims.x;
+  if (x1 < 0) x1 = nx;
   const int64_t ny = k.dims.y;
   const StencilAxis ay = stencilAxis(int(r % ny), k.dims.y, nx, k.spacing.y);
   const StencilAxis az = stencilAxis(int(r / ny), k.dims.z, int64_t(nx) * ny, k.spacing.z);
@@ -283,9 +296,10 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
     k.write(v, next);
     sums.add(k.kept(next) - c, c, k.nearBand);
   };
-  const int lo = nx < 2 ? nx : 2;
-  const int hi = nx - 2 > lo ? nx - 2 : lo;
-  for (int i = 0; i < lo; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
+  // [lo, hi): the span's voxels at least two from the row's ends (no x border within reach).
+  const int lo = spanInteriorBegin(x0, x1, nx);
+  const int hi = spanInteriorEnd(x1, nx, lo);
+  for (int i = x0; i < lo; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
   float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
       nearSumSquared[kLanes], nearCount[kLanes];
   for (int l = 0; l < kLanes; ++l)
@@ -309,7 +323,7 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
     }
   }
   for (; i < hi; ++i) single(i, inner);
-  for (; i < nx; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
+  for (; i < x1; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
   for (int l = 0; l < kLanes; ++l) {
     sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
     sums.sumAbs += double(sumAbs[l]);
@@ -329,7 +343,8 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r) {
 // interior is not a whole number of chunks ends with a chunk that overlaps the previous one: its
 // stores repeat the same values and its lanes already counted are left out of the sums.
 template <class K, class AY, class AZ>
-VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const AZ& az) {
+VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const AZ& az, int x0,
+                                      int x1) {
   constexpr int kLanes = 16;
   const int nx = k.dims.x;
   const size_t base = size_t(r) * size_t(nx);
@@ -341,13 +356,14 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
     k.write(v, next);
     sums.add(k.kept(next) - c, c, k.nearBand);
   };
-  const int lo = nx < 2 ? nx : 2;
-  const int hi = nx - 2 > lo ? nx - 2 : lo;
+  // [lo, hi): the span's voxels at least two from the row's ends (no x border within reach).
+  const int lo = spanInteriorBegin(x0, x1, nx);
+  const int hi = spanInteriorEnd(x1, nx, lo);
   if (hi - lo < kLanes) {
-    for (int i = 0; i < nx; ++i) single(i);
+    for (int i = x0; i < x1; ++i) single(i);
     return sums;
   }
-  for (int i = 0; i < lo; ++i) single(i);
+  for (int i = x0; i < lo; ++i) single(i);
   const InnerAxis ax = innerAxis(1, k.spacing.x);
   float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
       nearSumSquared[kLanes], nearCount[kLanes];
@@ -376,7 +392,7 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
     }
     done = i0 + kLanes;
   }
-  for (int i = hi; i < nx; ++i) single(i);
+  for (int i = hi; i < x1; ++i) single(i);
   for (int l = 0; l < kLanes; ++l) {
     sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
     sums.sumAbs += double(sumAbs[l]);
@@ -388,15 +404,17 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
   return sums;
 }
 
+// Voxels [x0, x1) of row r (x1 < 0: to the row's end): the band path runs spans of rows.
 template <class K>
-VISOPT_HD ChangeSums sweepStepRow(const K& k, int64_t r) {
+VISOPT_HD ChangeSums sweepStepRow(const K& k, int64_t r, int x0 = 0, int x1 = -1) {
   const int ny = k.dims.y, nz = k.dims.z;
   const int j = int(r % ny), l = int(r / ny);
   const int64_t sy = k.dims.x, sz = int64_t(k.dims.x) * ny;
+  if (x1 < 0) x1 = k.dims.x;
   if (j >= 2 && j < ny - 2 && l >= 2 && l < nz - 2)
-    return sweepStepRowWith(k, r, innerAxis(sy, k.spacing.y), innerAxis(sz, k.spacing.z));
+    return sweepStepRowWith(k, r, innerAxis(sy, k.spacing.y), innerAxis(sz, k.spacing.z), x0, x1);
   return sweepStepRowWith(k, r, stencilAxis(j, ny, sy, k.spacing.y),
-                          stencilAxis(l, nz, sz, k.spacing.z));
+                          stencilAxis(l, nz, sz, k.spacing.z), x0, x1);
 }
 
 // ---- the level-set step -----------------------------------------------------------------------
@@ -478,6 +496,9 @@ struct LevelSetStepKernel {
 
   VISOPT_HD ChangeSums voxel(int64_t v) const { return sweepVoxel(*this, v); }
   VISOPT_HD ChangeSums row(int64_t r) const { return sweepStepRow(*this, r); }
+  VISOPT_HD ChangeSums span(int64_t r, int x0, int x1) const {
+    return sweepStepRow(*this, r, x0, x1);
+  }
 };
 
 // Maxima over the grid that bound the stable time step (METHODS.md §3).

@@ -121,6 +121,7 @@ struct RedistanceKernel {
 
   VISOPT_HD ChangeSums voxel(int64_t v) const { return sweepVoxel(*this, v); }
   VISOPT_HD ChangeSums row(int64_t r) const { return sweepRow(*this, r); }
+  VISOPT_HD ChangeSums span(int64_t r, int x0, int x1) const { return sweepRow(*this, r, x0, x1); }
 };
 
 // Counts voxels next to the interface (no interface: nothing to measure distance to).

@@ -8,6 +8,10 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
 #include "core/device_bit_mask.h"
 #include "core/field_view.h"
 #include "exec/parallel.h"
@@ -44,6 +48,158 @@ T launchStencil(const char* name, const K& k, const glm::ivec3& dims) {
   if (activeBackend() == Backend::CUDA)
     return exec::reduce(name, rows * dims.x, T{}, VoxelOf<K>{k}, Plus{});
   return exec::reduce(name, rows, T{}, RowOf<K>{k}, Plus{});
+}
+
+// ---- the narrow band: x-spans of active bricks ------------------------------------------------
+//
+// A brick of kBrick^3 voxels is active when one of its voxels lies within the band's half-width
+// of the surface (|phi|) or of its base shape (|phi0|), or lies on different sides of the two
+// (phi and phi0 of opposite signs: the region the surface swept, where the return term of Eq. 23
+// can flip the sign back; left out, a surface relaxing from far away would leave its old inside
+// behind as a spurious one). Runs of active bricks along x become one span per voxel row, so the
+// kernels' row sweeps (vectorised along x) run over them unchanged. Host data: the band path
+// runs on the CPU backend.
+
+constexpr int kBrick = 8;
+
+struct RowSpan {
+  int64_t row;
+  int x0, x1;
+};
+
+struct Band {
+  std::vector<RowSpan> spans;
+  int64_t voxels = 0;  // voxels in the spans
+};
+
+// Per brick (x fastest) the smallest band distance of its voxels: min(|phi|, |phi0|), 0 where
+// the two differ in sign.
+std::vector<float> brickDistances(const Field3D& phi, const Field3D* phi0, const glm::ivec3& nb) {
+  std::vector<float> out(size_t(nb.x) * size_t(nb.y) * size_t(nb.z));
+  const FieldView p(phi);
+  const FieldView base = phi0 ? FieldView(*phi0) : FieldView(phi);
+  const glm::ivec3 d = phi.grid().dims;
+  float* dst = out.data();
+  // Host code (the band path runs on the CPU backend): TBB directly, not an exec:: launch.
+  tbb::parallel_for(int64_t(0), int64_t(nb.y) * nb.z, [=](int64_t brickRow) {
+    const int by = int(brickRow % nb.y), bz = int(brickRow / nb.y);
+    float* row = dst + size_t(nb.x) * size_t(brickRow);
+    for (int bx = 0; bx < nb.x; ++bx) row[bx] = std::numeric_limits<float>::infinity();
+    for (int k = bz * kBrick; k < std::min(d.z, (bz + 1) * kBrick); ++k)
+      for (int j = by * kBrick; j < std::min(d.y, (by + 1) * kBrick); ++j) {
+        const size_t rowStart = size_t(d.x) * (size_t(j) + size_t(d.y) * size_t(k));
+        for (int bx = 0; bx < nb.x; ++bx) {
+          float m = row[bx];
+          for (int i = bx * kBrick; i < std::min(d.x, (bx + 1) * kBrick); ++i) {
+            const float a = p.load(rowStart + size_t(i)), b = base.load(rowStart + size_t(i));
+            const float near = std::min(std::fabs(a), std::fabs(b));
+            m = std::min(m, (a < 0.f) != (b < 0.f) ? 0.f : near);
+          }
+          row[bx] = m;
+        }
+      }
+  });
+  return out;
+}
+
+// Row spans of the bricks whose flag is set, merged along x.
+void appendSpans(const std::vector<uint8_t>& flags, const glm::ivec3& nb, const glm::ivec3& d,
+                 std::vector<RowSpan>& spans, int64_t& voxels) {
+  for (int bz = 0; bz < nb.z; ++bz)
+    for (int by = 0; by < nb.y; ++by) {
+      const size_t brickRow = size_t(nb.x) * (size_t(by) + size_t(nb.y) * size_t(bz));
+      for (int bx = 0; bx < nb.x;) {
+        if (!flags[brickRow + size_t(bx)]) {
+          ++bx;
+          continue;
+        }
+        int end = bx + 1;
+        while (end < nb.x && flags[brickRow + size_t(end)]) ++end;
+        const int x0 = bx * kBrick, x1 = std::min(d.x, end * kBrick);
+        for (int k = bz * kBrick; k < std::min(d.z, (bz + 1) * kBrick); ++k)
+          for (int j = by * kBrick; j < std::min(d.y, (by + 1) * kBrick); ++j) {
+            spans.push_back({int64_t(j) + int64_t(d.y) * k, x0, x1});
+            voxels += x1 - x0;
+          }
+        bx = end;
+      }
+    }
+}
+
+// The band, and its halo: the active bricks and their 26 neighbours, which the stencils of the
+// band's voxels reach into (two voxels at most).
+struct BandWithHalo {
+  Band band, halo;
+};
+
+BandWithHalo narrowBand(const Field3D& phi, const Field3D* phi0, float halfWidthVoxels) {
+  const glm::ivec3 d = phi.grid().dims;
+  const glm::ivec3 nb = (d + glm::ivec3(kBrick - 1)) / kBrick;
+  const std::vector<float> minAbs = brickDistances(phi, phi0, nb);
+  const float limit = halfWidthVoxels * phi.grid().minSpacing();
+  std::vector<uint8_t> active(minAbs.size()), near(minAbs.size());
+  for (size_t b = 0; b < minAbs.size(); ++b) active[b] = minAbs[b] <= limit;
+  for (int bz = 0; bz < nb.z; ++bz)
+    for (int by = 0; by < nb.y; ++by)
+      for (int bx = 0; bx < nb.x; ++bx) {
+        if (!active[size_t(bx) + size_t(nb.x) * (size_t(by) + size_t(nb.y) * size_t(bz))]) continue;
+        for (int z = std::max(bz - 1, 0); z <= std::min(bz + 1, nb.z - 1); ++z)
+          for (int y = std::max(by - 1, 0); y <= std::min(by + 1, nb.y - 1); ++y)
+            for (int x = std::max(bx - 1, 0); x <= std::min(bx + 1, nb.x - 1); ++x)
+              near[size_t(x) + size_t(nb.x) * (size_t(y) + size_t(nb.y) * size_t(z))] = 1;
+      }
+  BandWithHalo out;
+  appendSpans(active, nb, d, out.band.spans, out.band.voxels);
+  appendSpans(near, nb, d, out.halo.spans, out.halo.voxels);
+  return out;
+}
+
+// to = from over the spans.
+void copySpans(const Field3D& from, Field3D& to, const Band& spans) {
+  const FieldView a(from), b(to);
+  const int64_t nx = from.grid().dims.x;
+  const RowSpan* list = spans.spans.data();
+  tbb::parallel_for(int64_t(0), int64_t(spans.spans.size()), [=](int64_t i) {
+    const size_t start = size_t(list[i].row * nx);
+    for (int x = list[i].x0; x < list[i].x1; ++x)
+      b.store(start + size_t(x), a.load(start + size_t(x)));
+  });
+}
+
+template <class K>
+struct SpanOf {
+  K k;
+  const RowSpan* spans;
+  VISOPT_HD auto operator()(int64_t i) const {
+    return k.span(spans[i].row, spans[i].x0, spans[i].x1);
+  }
+};
+
+template <class T, class K>
+T launchBand(const char* name, const K& k, const Band& band) {
+  return exec::reduce(name, int64_t(band.spans.size()), T{}, SpanOf<K>{k, band.spans.data()},
+                      Plus{});
+}
+
+// The band path: CPU backend and a positive half-width.
+bool useBand(const LevelSetSettings& s) {
+  return s.band > 0.f && activeBackend() == Backend::CPU;
+}
+
+// True when phi changes sign between neighbours at a voxel of the spans.
+bool interfaceWithin(const Field3D& phi, const Band& spans) {
+  const InterfaceCount count{FieldView(phi)};
+  const int64_t nx = phi.grid().dims.x;
+  const RowSpan* list = spans.spans.data();
+  return tbb::parallel_reduce(
+             tbb::blocked_range<int64_t>(0, int64_t(spans.spans.size())), int64_t(0),
+             [=](const tbb::blocked_range<int64_t>& r, int64_t found) {
+               for (int64_t i = r.begin(); i != r.end() && found == 0; ++i)
+                 for (int x = list[i].x0; x < list[i].x1 && found == 0; ++x)
+                   found += count(list[i].row * nx + x);
+               return found;
+             },
+             [](int64_t a, int64_t b) { return a + b; }) > 0;
 }
 
 // ---- storage dispatch -------------------------------------------------------------------------
@@ -109,8 +265,8 @@ float checkedCfl(const LevelSetSettings& s) {
 
 template <class A, int Order>
 ChangeSums substepWith(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                       const DeviceBitMask* mask, const LevelSetSettings& s, float dt,
-                       Field3D& out) {
+                       const DeviceBitMask* mask, const LevelSetSettings& s, float dt, Field3D& out,
+                       const Band* band) {
   const GridSpec& g = phi.grid();
   LevelSetStepKernel<A, Order> k;
   k.phi = accessOf(phi, Tag<A>{});
@@ -125,21 +281,23 @@ ChangeSums substepWith(const Field3D& phi, const Field3D& phi0, const Field3D& g
   k.curvatureEpsilon = s.curvatureEpsilon;
   k.kappaMax = 1.f / g.minSpacing();
   k.nearBand = kNearSurfaceBand * g.minSpacing();
+  if (band) return launchBand<ChangeSums>("level set: step (band)", k, *band);
   return launchStencil<ChangeSums>("level set: step", k, g.dims);
 }
 
 ChangeSums substep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
-                   const DeviceBitMask* mask, const LevelSetSettings& s, float dt, Field3D& out) {
+                   const DeviceBitMask* mask, const LevelSetSettings& s, float dt, Field3D& out,
+                   const Band* band = nullptr) {
   return dispatch({&phi, &phi0, &ghat, &out}, [&](auto tag) {
     using A = typename decltype(tag)::type;
-    return s.spatialOrder == 1 ? substepWith<A, 1>(phi, phi0, ghat, mask, s, dt, out)
-                               : substepWith<A, 2>(phi, phi0, ghat, mask, s, dt, out);
+    return s.spatialOrder == 1 ? substepWith<A, 1>(phi, phi0, ghat, mask, s, dt, out, band)
+                               : substepWith<A, 2>(phi, phi0, ghat, mask, s, dt, out, band);
   });
 }
 
 template <class A, int Order>
 double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, const Field3D* base,
-                          float stopBand) {
+                          float stopBand, const Band* band) {
   const GridSpec& g = in.grid();
   RedistanceKernel<A, Order> k;
   k.in = accessOf(in, Tag<A>{});
@@ -155,18 +313,21 @@ double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, cons
   k.dtau = (Order == 2 ? 0.3f : 0.5f) * k.dxMin;
   k.initialise = initialise;
   if (stopBand > 0.f) k.nearBand = stopBand * k.dxMin;
-  const ChangeSums c = launchStencil<ChangeSums>("level set: redistance", k, g.dims);
+  const ChangeSums c = band ? launchBand<ChangeSums>("level set: redistance (band)", k, *band)
+                            : launchStencil<ChangeSums>("level set: redistance", k, g.dims);
   if (stopBand > 0.f)
     return c.nearCount > 0.0 ? c.nearSumSquared / (double(k.dxMin) * k.dxMin) / c.nearCount : 0.0;
-  return c.sumSquared / (double(k.dxMin) * k.dxMin) / double(in.size());
+  const double voxels = band ? double(std::max<int64_t>(band->voxels, 1)) : double(in.size());
+  return c.sumSquared / (double(k.dxMin) * k.dxMin) / voxels;
 }
 
 double redistancePass(const Field3D& in, Field3D& out, bool initialise, int order,
-                      const Field3D* base = nullptr, float stopBand = 0.f) {
+                      const Field3D* base = nullptr, float stopBand = 0.f,
+                      const Band* band = nullptr) {
   auto run = [&](auto tag) {
     using A = typename decltype(tag)::type;
-    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base, stopBand)
-                      : redistancePassWith<A, 2>(in, out, initialise, base, stopBand);
+    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base, stopBand, band)
+                      : redistancePassWith<A, 2>(in, out, initialise, base, stopBand, band);
   };
   return base ? dispatch({&in, &out, base}, run) : dispatch({&in, &out}, run);
 }
@@ -212,16 +373,35 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   LevelSetStepStats stats;
   stats.timeStep = levelSetTimeStep(ghat, s);
   stats.substeps = s.substeps;
+  // The band path: the spans of active bricks, fixed for this call; outside them both buffers
+  // hold phi as it was (scratch starts as a copy), so the stencils at the spans' edges read the
+  // same values whichever buffer is the source.
+  BandWithHalo narrow;
+  const Band& band = narrow.band;
+  const bool banded = useBand(s) && s.substeps > 0;
+  if (banded) {
+    narrow = narrowBand(phi, &phi0, s.band);
+    stats.bandVoxels = band.voxels;
+    copySpans(phi, scratch, narrow.halo);
+  }
   Field3D* from = &phi;
   Field3D* to = &scratch;
   for (int n = 0; n < s.substeps; ++n) {
-    const ChangeSums c = substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to);
+    const ChangeSums c =
+        substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to, banded ? &band : nullptr);
     stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
     stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
     stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
     std::swap(from, to);
   }
-  if (from != &phi) copyField(*from, phi);
+  if (from != &phi) {
+    if (banded)
+      copySpans(*from, phi, band);
+    else
+      copyField(*from, phi);
+  }
+  // Outside the band's halo phi did not change and lies farther than the band from the surface.
+  stats.hasInterface = banded ? interfaceWithin(phi, narrow.halo) : hasInterface(phi);
   return stats;
 }
 
@@ -250,12 +430,21 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
     stats.converged = true;
     return stats;
   }
+  // The band path as in levelSetStep: spans fixed for the call, scratch a copy of phi.
+  BandWithHalo narrowed;
+  const Band& narrow = narrowed.band;
+  const bool banded = useBand(s) && s.redistanceIterations > 0;
+  if (banded) {
+    narrowed = narrowBand(phi, base, s.band);
+    stats.bandVoxels = narrow.voxels;
+    copySpans(phi, scratch, narrowed.halo);
+  }
   Field3D* from = &phi;
   Field3D* to = &scratch;
   for (int n = 0; n < s.redistanceIterations; ++n) {
     // The first pass also sets the interface band to its subcell distance (kept afterwards).
-    stats.meanSquaredChange =
-        redistancePass(*from, *to, n == 0, s.spatialOrder, base, std::max(stopBand, 0.f));
+    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder, base,
+                                             std::max(stopBand, 0.f), banded ? &narrow : nullptr);
     stats.iterations = n + 1;
     std::swap(from, to);
     if (stats.meanSquaredChange < double(s.redistanceTolerance)) {
@@ -263,7 +452,12 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
       break;
     }
   }
-  if (from != &phi) copyField(*from, phi);
+  if (from != &phi) {
+    if (banded)
+      copySpans(*from, phi, narrow);
+    else
+      copyField(*from, phi);
+  }
   return stats;
 }
 

@@ -37,7 +37,8 @@ const FieldTable<LevelSetSettings>& levelSetFields() {
                                 .add("reach", &S::reach)
                                 .add("redistanceIterations", &S::redistanceIterations)
                                 .add("redistanceTolerance", &S::redistanceTolerance)
-                                .add("spatialOrder", &S::spatialOrder);
+                                .add("spatialOrder", &S::spatialOrder)
+                                .add("band", &S::band);
   return table;
 }
 

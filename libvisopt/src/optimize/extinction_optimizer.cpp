@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "core/field_view.h"
 #include "core/frustum_map.h"
@@ -610,7 +611,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
       motion = std::max(motion, ls.nearMaxChange * n);
       farMotion = std::max(farMotion, ls.maxChange * n);
       rate = std::max(rate, ls.nearMaxChange);
-      anySurface = anySurface || hasInterface(L.phi[si]);
+      anySurface = anySurface || ls.hasInterface;
     }
     L.motionSinceRedistance += motion;
     L.farMotionSinceRedistance += farMotion;
@@ -700,6 +701,7 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
   for (int l = 0; l < s.levels; ++l) {
     buildLevel(in, s, l, s.levels);
     double last = 0.0;
+    std::optional<IterationStats> previous;
     for (int it = 0; it < s.maxIterationsPerLevel; ++it) {
       IterationStats st = runIteration(in, s, s.levels, s.maxIterationsPerLevel);
       all.push_back(st);
@@ -707,10 +709,22 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
       const double e = st.energy();
       const double rel = std::abs(e - last) / std::max(std::abs(e), 1e-30);
       last = e;
-      // A level ends when the energy has settled and the surfaces have: moving by less than a
-      // tenth of a voxel in the last iteration (the energy alone can stall while a surface is
-      // still on its way through an unimportant layer).
-      const bool surfacesSettled = st.levelSetMotionVoxels < 0.1;
+      // A level ends when the energy has settled and the surfaces have (the energy alone can
+      // stall while a surface is still on its way through an unimportant layer): they moved by
+      // less than a tenth of a voxel in the last iteration, or where they lie stopped changing.
+      // levelSetMotionVoxels bounds the motion by the largest change of any substep, so it
+      // also counts churn that goes nowhere: where the advection term (grad ghat . grad phi)
+      // pushes a surface out each substep and redistancing and the return term pull it back,
+      // it stays near a voxel per iteration at a standstill (builtin:ct-head: 0.9 voxel per
+      // iteration for 40 iterations while the deviation from the base stayed 0.057 voxel on
+      // average and 1.09 at most, to the third decimal). A surface on its way changes how far
+      // it lies from its base: both deviation statistics steady from one iteration to the next
+      // is a standstill.
+      const bool deviationSteady =
+          previous && std::abs(st.meanDeviationVoxels - previous->meanDeviationVoxels) < 0.002 &&
+          std::abs(st.maxDeviationVoxels - previous->maxDeviationVoxels) < 0.1;
+      const bool surfacesSettled = st.levelSetMotionVoxels < 0.1 || deviationSteady;
+      previous = st;
       if (it + 1 >= s.minIterationsPerLevel && rel < s.tolerance && surfacesSettled) break;
     }
   }

@@ -336,12 +336,11 @@ double redistancePass(const Field3D& in, Field3D& out, bool initialise, int orde
 
 // ---- the level-set step (Eq. 23) ------------------------------------------------------------
 
-double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s) {
+namespace {
+
+// dt from the bounds of ghat (the formula levelSetStep documents).
+double timeStepFrom(const StepBounds& b, const GridSpec& g, const LevelSetSettings& s) {
   const float cfl = checkedCfl(s);
-  const GridSpec& g = ghat.grid();
-  const StepBoundsKernel k{FieldView(ghat), g.dims, g.spacing};
-  StepBounds init;
-  const StepBounds b = exec::reduce("level set: time step", int64_t(ghat.size()), init, k, Plus{});
   const double h = g.minSpacing();
   double dt = std::numeric_limits<double>::infinity();
   if (b.maxGradG > 0.f) dt = std::min(dt, h / double(b.maxGradG));      // advection
@@ -350,6 +349,33 @@ double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s) {
   if (maxLambda > 0.0) dt = std::min(dt, 1.0 / maxLambda);  // relaxation
   if (!std::isfinite(dt)) dt = h * h;  // nothing moves: any bounded step will do
   return double(cfl) * dt;
+}
+
+// The bounds over the band's voxels only: stability matters only where phi is updated.
+StepBounds stepBoundsWithin(const Field3D& ghat, const Band& band) {
+  const GridSpec& g = ghat.grid();
+  const StepBoundsKernel k{FieldView(ghat), g.dims, g.spacing};
+  const int64_t nx = g.dims.x;
+  const RowSpan* list = band.spans.data();
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, int64_t(band.spans.size())), StepBounds{},
+      [=](const tbb::blocked_range<int64_t>& r, StepBounds b) {
+        for (int64_t i = r.begin(); i != r.end(); ++i)
+          for (int x = list[i].x0; x < list[i].x1; ++x) b = b + k(list[i].row * nx + x);
+        return b;
+      },
+      [](const StepBounds& a, const StepBounds& b) { return a + b; });
+}
+
+}  // namespace
+
+double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s) {
+  checkedCfl(s);
+  const GridSpec& g = ghat.grid();
+  const StepBoundsKernel k{FieldView(ghat), g.dims, g.spacing};
+  const StepBounds b =
+      exec::reduce("level set: time step", int64_t(ghat.size()), StepBounds{}, k, Plus{});
+  return timeStepFrom(b, g, s);
 }
 
 double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
@@ -371,7 +397,6 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   ensureLike(scratch, phi);
 
   LevelSetStepStats stats;
-  stats.timeStep = levelSetTimeStep(ghat, s);
   stats.substeps = s.substeps;
   // The band path: the spans of active bricks, fixed for this call; outside them both buffers
   // hold phi as it was (scratch starts as a copy), so the stencils at the spans' edges read the
@@ -383,6 +408,9 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
     narrow = narrowBand(phi, &phi0, s.band);
     stats.bandVoxels = band.voxels;
     copySpans(phi, scratch, narrow.halo);
+    stats.timeStep = timeStepFrom(stepBoundsWithin(ghat, band), ghat.grid(), s);
+  } else {
+    stats.timeStep = levelSetTimeStep(ghat, s);
   }
   Field3D* from = &phi;
   Field3D* to = &scratch;
@@ -424,18 +452,21 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
   checkOrder(s);
   ensureLike(scratch, phi);
   RedistanceStats stats;
-  const int64_t band = exec::reduce("level set: interface", int64_t(phi.size()), int64_t(0),
-                                    InterfaceCount{FieldView(phi)}, Plus{});
-  if (band == 0) {
-    stats.converged = true;
-    return stats;
-  }
-  // The band path as in levelSetStep: spans fixed for the call, scratch a copy of phi.
+  // The band path as in levelSetStep: spans fixed for the call, scratch a copy of phi over the
+  // band's halo. A surface lies within the band, so the band answers whether there is one.
   BandWithHalo narrowed;
   const Band& narrow = narrowed.band;
   const bool banded = useBand(s) && s.redistanceIterations > 0;
+  if (banded) narrowed = narrowBand(phi, base, s.band);
+  const bool surface = banded
+                           ? interfaceWithin(phi, narrowed.halo)
+                           : exec::reduce("level set: interface", int64_t(phi.size()), int64_t(0),
+                                          InterfaceCount{FieldView(phi)}, Plus{}) > 0;
+  if (!surface) {
+    stats.converged = true;
+    return stats;
+  }
   if (banded) {
-    narrowed = narrowBand(phi, base, s.band);
     stats.bandVoxels = narrow.voxels;
     copySpans(phi, scratch, narrowed.halo);
   }

@@ -15,6 +15,7 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "kernels/surface_shading.h"
+#include "level_set_fixtures.h"
 #include "optimize/level_set.h"
 #include "visopt/error.h"
 #include "visopt/field.h"
@@ -24,30 +25,7 @@
 namespace visopt {
 namespace {
 
-using Fn = std::function<float(glm::vec3)>;  // of the world position of a voxel centre
-
-GridSpec cube(int n, glm::vec3 spacing = glm::vec3(1.f)) {
-  GridSpec g;
-  g.dims = glm::ivec3(n);
-  g.spacing = spacing;
-  return g;
-}
-
-Field3D makeField(const char* name, const GridSpec& g, Precision p, const Fn& f) {
-  Field3D out(name, g, p);
-  for (int k = 0; k < g.dims.z; ++k)
-    for (int j = 0; j < g.dims.y; ++j)
-      for (int i = 0; i < g.dims.x; ++i)
-        out.set(g.linearIndex(i, j, k), f(g.indexToWorld(glm::vec3(i, j, k))));
-  return out;
-}
-
-Fn sphere(glm::vec3 centre, float radius) {
-  return [=](glm::vec3 x) { return glm::length(x - centre) - radius; };
-}
-Fn constant(float c) {
-  return [=](glm::vec3) { return c; };
-}
+using namespace testing_fixtures;
 
 float maxAbs(const Field3D& f) {
   float m = 0.f;
@@ -63,29 +41,6 @@ bool allFinite(const Field3D& f) {
   for (size_t v = 0; v < f.size(); ++v)
     if (!std::isfinite(f.get(v))) return false;
   return true;
-}
-
-// Volume of {phi < 0} with a linear partial-voxel fraction at the interface, as the radius
-// of the sphere of that volume.
-double equivalentRadius(const Field3D& phi) {
-  const glm::vec3 h = phi.grid().spacing;
-  const double hMin = phi.grid().minSpacing();
-  double volume = 0.0;
-  for (size_t v = 0; v < phi.size(); ++v)
-    volume += std::clamp(0.5 - double(phi.get(v)) / hMin, 0.0, 1.0);
-  volume *= double(h.x) * h.y * h.z;
-  return std::cbrt(3.0 * volume / (4.0 * std::numbers::pi));
-}
-
-// Evenly spread unit directions (a Fibonacci sphere).
-std::vector<glm::vec3> directions(int n) {
-  std::vector<glm::vec3> out;
-  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - z * z);
-    out.emplace_back(float(r * std::cos(golden * i)), float(r * std::sin(golden * i)), float(z));
-  }
-  return out;
 }
 
 // Largest |phi| (in voxels) sampled at points of an exact sphere: how far the zero level set

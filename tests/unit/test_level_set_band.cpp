@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/field_view.h"
+#include "level_set_fixtures.h"
 #include "optimize/level_set.h"
 #include "visopt/field.h"
 #include "visopt/level_set.h"
@@ -20,7 +21,7 @@
 namespace visopt {
 namespace {
 
-using Fn = std::function<float(glm::vec3)>;
+using namespace testing_fixtures;
 
 GridSpec box(glm::ivec3 dims) {
   GridSpec g;
@@ -29,29 +30,10 @@ GridSpec box(glm::ivec3 dims) {
   return g;
 }
 
-Field3D makeField(const char* name, const GridSpec& g, Precision p, const Fn& f) {
-  Field3D out(name, g, p);
-  for (int k = 0; k < g.dims.z; ++k)
-    for (int j = 0; j < g.dims.y; ++j)
-      for (int i = 0; i < g.dims.x; ++i)
-        out.set(g.linearIndex(i, j, k), f(g.indexToWorld(glm::vec3(i, j, k))));
-  return out;
-}
-
 Field3D clone(const Field3D& f) {
   Field3D out("phi", f.grid(), f.precision());
   for (size_t v = 0; v < f.size(); ++v) out.set(v, f.get(v));
   return out;
-}
-
-Fn sphere(glm::vec3 centre, float radius) {
-  return [=](glm::vec3 x) { return glm::length(x - centre) - radius; };
-}
-
-double equivalentRadius(const Field3D& phi) {
-  double volume = 0.0;
-  for (size_t v = 0; v < phi.size(); ++v) volume += std::clamp(0.5 - double(phi.get(v)), 0.0, 1.0);
-  return std::cbrt(3.0 * volume / (4.0 * std::numbers::pi));
 }
 
 // Largest |band - dense| over voxels within a voxel of the dense surface (|dense| <= 1), and
@@ -71,17 +53,6 @@ ZeroSetComparison compare(const Field3D& band, const Field3D& dense) {
     c.worst = std::max(c.worst, std::fabs(b - d));
   }
   return c;
-}
-
-// Evenly spread unit directions (a Fibonacci sphere).
-std::vector<glm::vec3> directions(int n) {
-  std::vector<glm::vec3> out;
-  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < n; ++i) {
-    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - z * z);
-    out.emplace_back(float(r * std::cos(golden * i)), float(r * std::sin(golden * i)), float(z));
-  }
-  return out;
 }
 
 // Where the zero level set of phi (trilinear) crosses the ray from `centre` along `dir`: the

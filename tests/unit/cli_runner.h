@@ -22,7 +22,11 @@ struct CliResult {
 inline CliResult runCli(const std::string& args, const std::string& subdir) {
   const std::filesystem::path dir = std::filesystem::path(VISOPT_TEST_TMP) / subdir;
   std::filesystem::create_directories(dir);
-  const std::string errFile = (dir / ("stderr-" + std::to_string(getpid()) + ".txt")).string();
+  // ctest runs tests as parallel processes: one stderr file per process and call.
+  static int calls = 0;
+  const std::string errFile =
+      (dir / ("stderr-" + std::to_string(getpid()) + "-" + std::to_string(calls++) + ".txt"))
+          .string();
   const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
   CliResult r;
   FILE* pipe = popen(cmd.c_str(), "r");

@@ -12,36 +12,17 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.h"
 #include "visopt/image.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
+using Result = visopt::testing::CliResult;
 
 Result run(const std::string& args) {
-  const fs::path dir = fs::path(VISOPT_TEST_TMP) / "cli";
-  fs::create_directories(dir);
-  // ctest runs the tests of this file as parallel processes: one stderr file per call.
-  static int calls = 0;
-  const std::string errFile =
-      (dir / ("stderr-" + std::to_string(getpid()) + "-" + std::to_string(calls++) + ".txt"))
-          .string();
-  const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
-  Result r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(errFile);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
+  return visopt::testing::runCli(args, "cli");
 }
 
 std::string tmp(const std::string& name) {

@@ -19,6 +19,7 @@
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.h"
 #include "core/field_view.h"
 #include "visopt/error.h"
 #include "visopt/sdf.h"
@@ -604,24 +605,10 @@ TEST(MeshSdf, BadOptionsAreUsageErrors) {
 
 namespace {
 
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
+using Result = visopt::testing::CliResult;
 
 Result runCli(const std::string& args) {
-  const std::string errFile = tmp("cli_stderr.txt");
-  const std::string cmd = std::string(VISOPT_CLI) + " " + args + " 2>" + errFile;
-  Result r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(errFile);
-  r.err.assign(std::istreambuf_iterator<char>(e), {});
-  return r;
+  return visopt::testing::runCli(args, "mesh-sdf-cli");
 }
 
 }  // namespace

@@ -250,6 +250,15 @@ void copyField(const Field3D& from, Field3D& to) {
                     [=] VISOPT_HD(int64_t v) { b.store(size_t(v), a.load(size_t(v))); });
 }
 
+// The result of a ping-pong loop back into phi: over the band only when there is one (nothing
+// else was written).
+void copyResult(const Field3D& from, Field3D& phi, const Band* band) {
+  if (band)
+    copySpans(from, phi, *band);
+  else
+    copyField(from, phi);
+}
+
 void checkOrder(const LevelSetSettings& s) {
   if (s.spatialOrder != 1 && s.spatialOrder != 2)
     throw Error(ErrorKind::Usage, "level set: the spatial order must be 1 or 2");
@@ -398,9 +407,9 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
 
   LevelSetStepStats stats;
   stats.substeps = s.substeps;
-  // The band path: the spans of active bricks, fixed for this call; outside them both buffers
-  // hold phi as it was (scratch starts as a copy), so the stencils at the spans' edges read the
-  // same values whichever buffer is the source.
+  // The band path: the spans of active bricks, fixed for this call. Scratch starts as a copy of
+  // phi over the band's halo (as far as the stencils reach) and only the band is written, so the
+  // stencils at the spans' edges read the same values whichever buffer is the source.
   BandWithHalo narrow;
   const Band& band = narrow.band;
   const bool banded = useBand(s) && s.substeps > 0;
@@ -422,12 +431,7 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
     stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
     std::swap(from, to);
   }
-  if (from != &phi) {
-    if (banded)
-      copySpans(*from, phi, band);
-    else
-      copyField(*from, phi);
-  }
+  if (from != &phi) copyResult(*from, phi, banded ? &band : nullptr);
   // Outside the band's halo phi did not change and lies farther than the band from the surface.
   stats.hasInterface = banded ? interfaceWithin(phi, narrow.halo) : hasInterface(phi);
   return stats;
@@ -458,10 +462,7 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
   const Band& narrow = narrowed.band;
   const bool banded = useBand(s) && s.redistanceIterations > 0;
   if (banded) narrowed = narrowBand(phi, base, s.band);
-  const bool surface = banded
-                           ? interfaceWithin(phi, narrowed.halo)
-                           : exec::reduce("level set: interface", int64_t(phi.size()), int64_t(0),
-                                          InterfaceCount{FieldView(phi)}, Plus{}) > 0;
+  const bool surface = banded ? interfaceWithin(phi, narrowed.halo) : hasInterface(phi);
   if (!surface) {
     stats.converged = true;
     return stats;
@@ -483,12 +484,7 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
       break;
     }
   }
-  if (from != &phi) {
-    if (banded)
-      copySpans(*from, phi, narrow);
-    else
-      copyField(*from, phi);
-  }
+  if (from != &phi) copyResult(*from, phi, banded ? &narrow : nullptr);
   return stats;
 }
 

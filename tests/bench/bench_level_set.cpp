@@ -20,6 +20,7 @@
 #include <cstdint>
 
 #include "optimize/level_set.h"
+#include "optimize/narrow_band.h"
 #include "visopt/field.h"
 #include "visopt/level_set.h"
 
@@ -116,10 +117,11 @@ void BM_OpenVdbRenormalize(benchmark::State& state) {
 
 // The band path as the optimiser runs it, per iteration: one level-set substep (Eq. 23) and one
 // redistancing iteration (Eq. 18), each over the active bricks of a band of half-width
-// range(2) voxels (LevelSetSettings::band), the band rebuilt by each call (a read pass over phi
-// and phi0 of the whole grid: the storage is still dense). ns_per_voxel divides by the band's
-// voxels (bricks of 8^3 within the half-width of the surface, so more than OpenVDB's band of
-// the same half-width).
+// range(2) voxels (LevelSetSettings::band). range(3) = 1: the band is kept between calls and
+// moved with the surface (NarrowBand, as the optimiser does: the bricks' distances are read
+// again over the band only); 0: each call finds it again by a read pass over phi and phi0 of
+// the whole grid. ns_per_voxel divides by the band's voxels (bricks of 8^3 within the
+// half-width of the surface, so more than OpenVDB's band of the same half-width).
 void BM_BandStepRedist(benchmark::State& state) {
   const int n = int(state.range(0));
   DenseSetup d(n, precisionOf(state.range(1)));
@@ -127,12 +129,15 @@ void BM_BandStepRedist(benchmark::State& state) {
   s.band = float(state.range(2));
   s.substeps = 1;
   s.redistanceIterations = 1;
+  const bool kept = state.range(3) != 0;
   visopt::Field3D scratch;
+  visopt::NarrowBand band;
   int64_t bandVoxels = 0;
   for (auto _ : state) {
+    visopt::NarrowBand* b = kept ? &band : nullptr;
     const visopt::LevelSetStepStats st =
-        visopt::levelSetStep(d.phi, d.phi0, d.ghat, nullptr, s, scratch);
-    const visopt::RedistanceStats rs = visopt::redistance(d.phi, s, scratch, &d.phi0);
+        visopt::levelSetStep(d.phi, d.phi0, d.ghat, nullptr, s, scratch, b);
+    const visopt::RedistanceStats rs = visopt::redistance(d.phi, s, scratch, &d.phi0, 0.f, b);
     bandVoxels = std::max(st.bandVoxels, rs.bandVoxels);
     benchmark::DoNotOptimize(rs.meanSquaredChange);
   }
@@ -183,11 +188,12 @@ BENCHMARK(BM_Redist)
 void bandArgs(benchmark::internal::Benchmark* b) {
   for (int n : {128, 256})
     for (int p : {32, 16})
-      for (int halfWidth : {3, 8}) b->Args({n, p, halfWidth});
+      for (int halfWidth : {3, 8})
+        for (int kept : {1, 0}) b->Args({n, p, halfWidth, kept});
 }
 BENCHMARK(BM_BandStepRedist)
     ->Apply(bandArgs)
-    ->ArgNames({"n", "fp", "band"})
+    ->ArgNames({"n", "fp", "band", "kept"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_OpenVdbCurvatureStep)

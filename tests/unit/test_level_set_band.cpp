@@ -15,6 +15,7 @@
 #include "core/field_view.h"
 #include "level_set_fixtures.h"
 #include "optimize/level_set.h"
+#include "optimize/narrow_band.h"
 #include "visopt/field.h"
 #include "visopt/level_set.h"
 
@@ -147,6 +148,81 @@ TEST_P(LevelSetBand, MeanCurvatureFlowMatchesTheDensePath) {
   // The band is a band: the sphere's shell of bricks and the region it swept, not the box.
   EXPECT_GT(most, 0);
   EXPECT_LT(double(most), 0.5 * double(g.voxelCount()));
+}
+
+// The band kept between calls (NarrowBand) follows a surface that moves 30 voxels: mean-curvature
+// flow (lambda = 0, so no band around phi0) shrinks a sphere of radius 36 to 6 (r^2 = R^2 - 4 c t).
+// The inner bricks hold the start's distances until the surface comes near; they must be claimed
+// across the faces of the active bricks as it does, or the surface stops at the band's old inner
+// edge. Checks: the radius follows the analytic one; every voxel within the half-width of the
+// final surface lies in an active brick (no holes); no active brick is far from it (no stale
+// bricks) and the active set shrank with the surface.
+TEST_P(LevelSetBand, TheBandFollowsASurfaceThirtyVoxels) {
+  const GridSpec g = box(glm::ivec3(80, 80, 80));
+  const glm::vec3 centre(39.4f, 39.7f, 39.6f);
+  const float startRadius = 36.f, endRadius = 6.f, c = 1.f;
+  const Field3D phi0 = makeField("phi0", g, GetParam(), sphere(centre, startRadius));
+  const Field3D ghat = makeField("ghat", g, GetParam(), [=](glm::vec3) { return c; });
+  LevelSetSettings s;
+  s.lambda = 0.f;
+  s.substeps = 8;
+  Field3D phi = clone(phi0), scratch;
+  NarrowBand band;
+  double t = 0.0;
+  const double tEnd =
+      (double(startRadius) * startRadius - double(endRadius) * endRadius) / (4.0 * c);
+  int64_t firstBricks = -1, released = 0, activated = 0;
+  double worstRadius = 0.0;
+  while (t < tEnd) {
+    const LevelSetStepStats st = levelSetStep(phi, phi0, ghat, nullptr, s, scratch, &band);
+    if (firstBricks < 0) firstBricks = band.activeBricks();
+    released += band.lastReleased();
+    activated += band.lastActivated();
+    t += st.timeStep * st.substeps;
+    redistance(phi, s, scratch, &phi0, 3.f, &band);
+    released += band.lastReleased();
+    activated += band.lastActivated();
+    const double expected =
+        std::sqrt(std::max(0.0, double(startRadius) * startRadius - 4.0 * c * t));
+    if (expected > 2.0 * endRadius)
+      worstRadius = std::max(worstRadius, std::fabs(equivalentRadius(phi) - expected));
+  }
+  const double expected = std::sqrt(std::max(0.0, double(startRadius) * startRadius - 4.0 * c * t));
+  const double radius = equivalentRadius(phi);
+  // Coverage and staleness, against the analytic sphere of the final radius.
+  std::vector<uint8_t> inBand(g.voxelCount(), 0);
+  for (const RowSpan& r : band.band().spans)
+    for (int x = r.x0; x < r.x1; ++x) inBand[size_t(r.row * g.dims.x + x)] = 1;
+  int holes = 0, covered = 0;
+  float farthest = 0.f;
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = 0; j < g.dims.y; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const float dist = std::fabs(glm::length(glm::vec3(i, j, k) - centre) - float(expected));
+        const size_t v = g.linearIndex(i, j, k);
+        if (dist <= s.band) {
+          ++covered;
+          holes += !inBand[v];
+        }
+        if (inBand[v]) farthest = std::max(farthest, dist);
+      }
+  std::printf(
+      "band follows MCF 36 -> 6: r %.3f, analytic %.3f (worst %.3f on the way); %lld bricks at "
+      "the start, %lld at the end, %lld activated and %lld released; %d holes of %d voxels "
+      "within the half-width; farthest band voxel %.1f voxels from the surface\n",
+      radius, expected, worstRadius, static_cast<long long>(firstBricks),
+      static_cast<long long>(band.activeBricks()), static_cast<long long>(activated),
+      static_cast<long long>(released), holes, covered, farthest);
+  EXPECT_NEAR(radius, expected, 0.3);
+  EXPECT_LT(worstRadius, 0.3);
+  EXPECT_GT(covered, 1000);
+  EXPECT_EQ(holes, 0);
+  // A face-claimed brick's nearest voxel lies within half-width + 1 + margin of the surface; its
+  // farthest at most a brick diagonal more.
+  EXPECT_LT(farthest, s.band + 1.f + NarrowBand::kReleaseMarginVoxels + std::sqrt(3.f) * kBrick);
+  EXPECT_GT(activated, 0);
+  EXPECT_GT(released, 0);
+  EXPECT_LT(band.activeBricks(), firstBricks / 4);
 }
 
 // No importance, a large return term: phi starts as a sphere of radius 30 and must become phi0,

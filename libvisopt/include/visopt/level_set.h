@@ -55,10 +55,14 @@ struct LevelSetStepStats {
   double timeStep = 0.0;  // dt of one substep
   int substeps = 0;
   double maxChange = 0.0;  // max |delta phi| of one substep, world units
-  // max |delta phi| of one substep over voxels within kNearSurfaceBand voxels of the surface:
-  // how far the surface itself moved (the far field's kinks move faster, and matter only when
-  // a surface comes near them).
+  // How far the surface itself moved in one substep: the largest |delta phi| x (1 - |phi| / dx)
+  // over voxels within kNearSurfaceBand voxels of the surface (the share of a change at a voxel
+  // that moves the zero set on its edges; kernels/level_set_step.h surfaceShare). The far
+  // field's kinks move faster, and matter only when a surface comes near them.
   double nearMaxChange = 0.0;
+  // max rise of phi of one substep over voxels inside the surface beyond kNearSurfaceBand: how
+  // fast a kink of the inside can come up towards zero (ChangeSums::insideRiseMax).
+  double insideRise = 0.0;
   double meanChange = 0.0;    // mean |delta phi| per substep
   int64_t bandVoxels = 0;     // voxels the band path ran over (0: the whole grid)
   bool hasInterface = false;  // phi has a surface after the step (a sign change somewhere)

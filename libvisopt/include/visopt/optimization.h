@@ -1,6 +1,7 @@
 // Settings and statistics of the visibility optimisation (paper 000 §II-C, Eqs. 10-14).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -61,9 +62,12 @@ struct IterationStats {
   double gridUpdatesMs = 0.0;     // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
   double extinctionStepMs = 0.0;  // gather, optimiser step, projection ("Ext. Opt.")
   // Context surfaces (paper 000 Eqs. 18-23), when there are any.
-  double sdfStepMs = 0.0;     // ghat gather and the level-set step ("SDF Opt.")
-  double redistanceMs = 0.0;  // all redistancing iterations ("Redist." x iterations)
-  int redistanceIterations = 0;
+  double sdfStepMs = 0.0;           // ghat gather and the level-set step ("SDF Opt.")
+  double redistanceMs = 0.0;        // all redistancing iterations ("Redist." x iterations)
+  int redistanceIterations = 0;     // the most of one redistancing call
+  int redistanceCalls = 0;          // redistancing calls (all surfaces)
+  int redistancePasses = 0;         // redistancing iterations of all calls
+  int64_t bandVoxels = 0;           // voxels of the surfaces' narrow bands at the end (0: dense)
   double redistanceResidual = 0.0;  // mean squared change of the last iteration (voxels^2)
   double levelSetTimeStep = 0.0;
   int levelSetSubsteps = 0;           // substeps of Eq. 23 this iteration

@@ -215,10 +215,20 @@ VISOPT_HD VISOPT_INLINE float godunovSquared(const OneSided& d, bool positiveSpe
   return maxOf(a * a, b * b);
 }
 
-// Per-launch reduction of a step: largest and summed |delta phi|, and the largest |delta phi|
-// among voxels within the kernel's nearBand of the surface (|phi| <= nearBand before the step):
-// how far the surface itself moved, which the far field's kinks (moving at up to ghat / dx)
-// do not inflate.
+// How much of a change of phi at a voxel moves the zero level set next to it, for a voxel
+// within `band` of the surface: a crossing on the edge between voxels A and B (opposite signs,
+// |A| + |B| ~ dx for a distance function) lies |A| / (|A| + |B|) of the way from A, so a change
+// d at A moves it by ~(1 - |A| / dx) d. With band = dx: 1 at the surface, 0 a voxel away (where
+// the fixed point of Eq. 23, which is no distance function, and redistancing pull a voxel to
+// and fro while the surface stays put).
+VISOPT_HD VISOPT_INLINE float surfaceShare(float phi, float band) {
+  return band > 0.f ? maxOf(0.f, 1.f - fabsf(phi) / band) : 1.f;
+}
+
+// Per-launch reduction of a step: largest and summed |delta phi|, and the largest
+// |delta phi| x surfaceShare among voxels within the kernel's nearBand of the surface
+// (|phi| <= nearBand before the step): how far the surface itself moved, which the far field's
+// kinks (moving at up to ghat / dx) do not inflate.
 struct ChangeSums {
   float maxAbs = 0.f;
   double sumAbs = 0.0;
@@ -226,10 +236,20 @@ struct ChangeSums {
   float nearMaxAbs = 0.f;
   double nearSumSquared = 0.0;  // sum of delta phi^2 over the voxels within nearBand
   double nearCount = 0.0;       // how many voxels lie within nearBand
+  // The largest rise of phi among voxels inside the surface beyond nearBand (phi < -nearBand):
+  // how fast a kink of the inside (its medial axis, raised by the clamped curvature) can come up
+  // to zero away from the surface. Elsewhere far from the surface phi can only fall towards a
+  // phi0 of the same sign or rise away from zero, so no spurious surface can start there (where
+  // phi0 has the other sign, the return term of Eq. 23 brings the surface back: real motion).
+  float insideRiseMax = 0.f;
   VISOPT_HD ChangeSums operator+(const ChangeSums& o) const {
-    return {maxOf(maxAbs, o.maxAbs),           sumAbs + o.sumAbs,
-            sumSquared + o.sumSquared,         maxOf(nearMaxAbs, o.nearMaxAbs),
-            nearSumSquared + o.nearSumSquared, nearCount + o.nearCount};
+    return {maxOf(maxAbs, o.maxAbs),
+            sumAbs + o.sumAbs,
+            sumSquared + o.sumSquared,
+            maxOf(nearMaxAbs, o.nearMaxAbs),
+            nearSumSquared + o.nearSumSquared,
+            nearCount + o.nearCount,
+            maxOf(insideRiseMax, o.insideRiseMax)};
   }
   VISOPT_HD void add(float d, float before, float nearBand) {
     const float a = fabsf(d);
@@ -237,9 +257,10 @@ struct ChangeSums {
     sumAbs += double(a);
     sumSquared += double(d) * double(d);
     const bool near = fabsf(before) <= nearBand;
-    nearMaxAbs = maxOf(nearMaxAbs, near ? a : 0.f);
+    nearMaxAbs = maxOf(nearMaxAbs, near ? a * surfaceShare(before, nearBand) : 0.f);
     nearSumSquared += near ? double(d) * double(d) : 0.0;
     nearCount += near ? 1.0 : 0.0;
+    insideRiseMax = maxOf(insideRiseMax, before < -nearBand ? maxOf(d, 0.f) : 0.f);
   }
 };
 
@@ -301,9 +322,10 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r, int x0 = 0, int x1 = -1) {
   const int hi = spanInteriorEnd(x1, nx, lo);
   for (int i = x0; i < lo; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
   float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
-      nearSumSquared[kLanes], nearCount[kLanes];
+      nearSumSquared[kLanes], nearCount[kLanes], insideRiseMax[kLanes];
   for (int l = 0; l < kLanes; ++l)
-    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] = 0.f;
+    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] =
+        insideRiseMax[l] = 0.f;
   int i = lo;
   for (; i + kLanes <= hi; i += kLanes) {
     const size_t v0 = base + size_t(i);
@@ -317,9 +339,10 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r, int x0 = 0, int x1 = -1) {
       sumAbs[l] += fabsf(d);
       sumSquared[l] += d * d;
       const bool near = fabsf(c) <= k.nearBand;
-      nearMaxAbs[l] = maxOf(nearMaxAbs[l], near ? fabsf(d) : 0.f);
+      nearMaxAbs[l] = maxOf(nearMaxAbs[l], near ? fabsf(d) * surfaceShare(c, k.nearBand) : 0.f);
       nearSumSquared[l] += near ? d * d : 0.f;
       nearCount[l] += near ? 1.f : 0.f;
+      insideRiseMax[l] = maxOf(insideRiseMax[l], c < -k.nearBand ? maxOf(d, 0.f) : 0.f);
     }
   }
   for (; i < hi; ++i) single(i, inner);
@@ -331,6 +354,7 @@ VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r, int x0 = 0, int x1 = -1) {
     sums.nearMaxAbs = maxOf(sums.nearMaxAbs, nearMaxAbs[l]);
     sums.nearSumSquared += double(nearSumSquared[l]);
     sums.nearCount += double(nearCount[l]);
+    sums.insideRiseMax = maxOf(sums.insideRiseMax, insideRiseMax[l]);
   }
   return sums;
 }
@@ -366,9 +390,10 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
   for (int i = x0; i < lo; ++i) single(i);
   const InnerAxis ax = innerAxis(1, k.spacing.x);
   float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
-      nearSumSquared[kLanes], nearCount[kLanes];
+      nearSumSquared[kLanes], nearCount[kLanes], insideRiseMax[kLanes];
   for (int l = 0; l < kLanes; ++l)
-    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] = 0.f;
+    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] =
+        insideRiseMax[l] = 0.f;
   for (int done = lo; done < hi;) {
     const int i0 = done + kLanes <= hi ? done : hi - kLanes;
     const size_t v0 = base + size_t(i0);
@@ -386,9 +411,11 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
       sumAbs[l] += fabsf(d);
       sumSquared[l] += d * d;
       const bool near = fabsf(current[l]) <= k.nearBand && i0 + l >= done;
-      nearMaxAbs[l] = maxOf(nearMaxAbs[l], near ? fabsf(d) : 0.f);
+      nearMaxAbs[l] =
+          maxOf(nearMaxAbs[l], near ? fabsf(d) * surfaceShare(current[l], k.nearBand) : 0.f);
       nearSumSquared[l] += near ? d * d : 0.f;
       nearCount[l] += near ? 1.f : 0.f;
+      insideRiseMax[l] = maxOf(insideRiseMax[l], current[l] < -k.nearBand ? maxOf(d, 0.f) : 0.f);
     }
     done = i0 + kLanes;
   }
@@ -400,6 +427,7 @@ VISOPT_HD ChangeSums sweepStepRowWith(const K& k, int64_t r, const AY& ay, const
     sums.nearMaxAbs = maxOf(sums.nearMaxAbs, nearMaxAbs[l]);
     sums.nearSumSquared += double(nearSumSquared[l]);
     sums.nearCount += double(nearCount[l]);
+    sums.insideRiseMax = maxOf(sums.insideRiseMax, insideRiseMax[l]);
   }
   return sums;
 }

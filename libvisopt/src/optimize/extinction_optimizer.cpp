@@ -11,6 +11,7 @@
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan.h"
 #include "optimize/level_set.h"
+#include "optimize/narrow_band.h"
 #include "visopt/error.h"
 
 namespace visopt {
@@ -144,6 +145,7 @@ struct ExtinctionOptimizer::Level {
   // Context surfaces: phi per surface, phi0 on coarse levels (the finest uses the inputs'),
   // the world mask on coarse levels, ghat, the frustum maxima of g and level-set scratch.
   std::vector<Field3D> phi, phi0;
+  std::vector<NarrowBand> bands;  // per surface: the narrow band of the level-set numerics
   std::optional<DeviceBitMask> mask;
   std::optional<Field3D> ghat, viewMax, lightMax, scratch;
   FrustumGrid view, light;
@@ -152,7 +154,7 @@ struct ExtinctionOptimizer::Level {
   float gradientScale = 1.f;
   double motionSinceRedistance = 0.0;  // bound on the surfaces' motion since the last redistancing
   int substeps = 0;                    // level-set substeps per iteration (LevelSetSettings::reach)
-  double farMotionSinceRedistance = 0.0;  // the same over the whole grid
+  double farMotionSinceRedistance = 0.0;  // bound on the inside's rise (LevelSetStepStats)
   double lastMotion = 0.0;  // bound on how far the surfaces moved in the last iteration, world
                             // units
   double lastEnergy = 0.0;
@@ -401,6 +403,7 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
       resample(next->finest ? base : next->phi0.back(), next->finest ? fineMap : map,
                next->phi.back());
   }
+  next->bands.resize(next->phi.size());
   if (!in.surfaceBases.empty()) {
     next->ghat.emplace("importance-behind", grid, precision_, ledger_);
     next->scratch.emplace("surface-scratch", grid, precision_, ledger_);
@@ -606,10 +609,10 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     bool anySurface = false;
     for (size_t si = 0; si < L.phi.size(); ++si) {
       const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
-      ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, chunkSettings, *L.scratch);
+      ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, chunkSettings, *L.scratch, &L.bands[si]);
       const double n = double(std::max(ls.substeps, 1));
       motion = std::max(motion, ls.nearMaxChange * n);
-      farMotion = std::max(farMotion, ls.maxChange * n);
+      farMotion = std::max(farMotion, ls.insideRise * n);
       rate = std::max(rate, ls.nearMaxChange);
       anySurface = anySurface || ls.hasInterface;
     }
@@ -618,15 +621,24 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     L.lastMotion += motion;
     st.sdfStepMs += msSince(ts);
     auto t1 = Clock::now();
-    // Also once the far field may have drifted by two voxels: its kinks (the medial axis,
-    // where the clamped curvature moves phi by up to ghat / dx) must not rise through zero more
-    // than kNearSurfaceBand voxels away from the surface.
-    if (L.motionSinceRedistance >= 0.5 * h || L.farMotionSinceRedistance >= 2.0 * h) {
+    // Also once a kink of the inside (the medial axis, where the clamped curvature raises phi
+    // by up to ghat / dx) may have risen by kNearSurfaceBand voxels: one that lay beyond the
+    // near band must not reach zero, which would start a spurious surface away from the real
+    // one. Only the inside's rise counts: far from the surface phi elsewhere relaxes towards a
+    // phi0 of its own sign or moves away from zero. (The whole field's largest change counted
+    // before; near the fixed point of Eq. 23, which is no distance function, the return term
+    // pulls voxels a voxel or so outside an opened surface back towards phi0 by ~0.2 voxel per
+    // substep while redistancing pushes them out again, which ran redistancing every ten
+    // substeps without any surface moving.)
+    if (L.motionSinceRedistance >= 0.5 * h ||
+        L.farMotionSinceRedistance >= double(kNearSurfaceBand) * h) {
       for (size_t si = 0; si < L.phi.size(); ++si) {
         const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
-        RedistanceStats rs =
-            redistance(L.phi[si], in.levelSet, *L.scratch, &phi0, kRedistanceStopBand);
+        RedistanceStats rs = redistance(L.phi[si], in.levelSet, *L.scratch, &phi0,
+                                        kRedistanceStopBand, &L.bands[si]);
         st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
+        ++st.redistanceCalls;
+        st.redistancePasses += rs.iterations;
         st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
       }
       L.motionSinceRedistance = 0.0;
@@ -641,6 +653,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     const double fits = rate > 0.0 ? 0.5 * h / rate : 64.0;
     chunk = int(std::clamp(std::floor(fits), double(std::max(in.levelSet.substeps, 1)), 64.0));
   }
+  for (const NarrowBand& b : L.bands) st.bandVoxels += b.band().voxels;
   st.levelSetTimeStep = ls.timeStep;
   st.levelSetSubsteps = std::max(L.substeps, 1);
   st.levelSetMotionVoxels = L.lastMotion / h;

@@ -17,6 +17,7 @@
 #include "exec/parallel.h"
 #include "kernels/level_set_step.h"
 #include "kernels/redistance.h"
+#include "optimize/narrow_band.h"
 #include "visopt/error.h"
 
 namespace visopt {
@@ -50,109 +51,13 @@ T launchStencil(const char* name, const K& k, const glm::ivec3& dims) {
   return exec::reduce(name, rows, T{}, RowOf<K>{k}, Plus{});
 }
 
-// ---- the narrow band: x-spans of active bricks ------------------------------------------------
+// ---- the narrow band (optimize/narrow_band.h): x-spans of active bricks --------------------
 //
-// A brick of kBrick^3 voxels is active when one of its voxels lies within the band's half-width
-// of the surface (|phi|) or of its base shape (|phi0|), or lies on different sides of the two
-// (phi and phi0 of opposite signs: the region the surface swept, where the return term of Eq. 23
-// can flip the sign back; left out, a surface relaxing from far away would leave its old inside
-// behind as a spurious one). Runs of active bricks along x become one span per voxel row, so the
-// kernels' row sweeps (vectorised along x) run over them unchanged. Host data: the band path
-// runs on the CPU backend.
+// Runs of active bricks along x are one span per voxel row, so the kernels' row sweeps
+// (vectorised along x) run over them unchanged. Host data: the band path runs on the CPU
+// backend.
 
-constexpr int kBrick = 8;
-
-struct RowSpan {
-  int64_t row;
-  int x0, x1;
-};
-
-struct Band {
-  std::vector<RowSpan> spans;
-  int64_t voxels = 0;  // voxels in the spans
-};
-
-// Per brick (x fastest) the smallest band distance of its voxels: min(|phi|, |phi0|), 0 where
-// the two differ in sign.
-std::vector<float> brickDistances(const Field3D& phi, const Field3D* phi0, const glm::ivec3& nb) {
-  std::vector<float> out(size_t(nb.x) * size_t(nb.y) * size_t(nb.z));
-  const FieldView p(phi);
-  const FieldView base = phi0 ? FieldView(*phi0) : FieldView(phi);
-  const glm::ivec3 d = phi.grid().dims;
-  float* dst = out.data();
-  // Host code (the band path runs on the CPU backend): TBB directly, not an exec:: launch.
-  tbb::parallel_for(int64_t(0), int64_t(nb.y) * nb.z, [=](int64_t brickRow) {
-    const int by = int(brickRow % nb.y), bz = int(brickRow / nb.y);
-    float* row = dst + size_t(nb.x) * size_t(brickRow);
-    for (int bx = 0; bx < nb.x; ++bx) row[bx] = std::numeric_limits<float>::infinity();
-    for (int k = bz * kBrick; k < std::min(d.z, (bz + 1) * kBrick); ++k)
-      for (int j = by * kBrick; j < std::min(d.y, (by + 1) * kBrick); ++j) {
-        const size_t rowStart = size_t(d.x) * (size_t(j) + size_t(d.y) * size_t(k));
-        for (int bx = 0; bx < nb.x; ++bx) {
-          float m = row[bx];
-          for (int i = bx * kBrick; i < std::min(d.x, (bx + 1) * kBrick); ++i) {
-            const float a = p.load(rowStart + size_t(i)), b = base.load(rowStart + size_t(i));
-            const float near = std::min(std::fabs(a), std::fabs(b));
-            m = std::min(m, (a < 0.f) != (b < 0.f) ? 0.f : near);
-          }
-          row[bx] = m;
-        }
-      }
-  });
-  return out;
-}
-
-// Row spans of the bricks whose flag is set, merged along x.
-void appendSpans(const std::vector<uint8_t>& flags, const glm::ivec3& nb, const glm::ivec3& d,
-                 std::vector<RowSpan>& spans, int64_t& voxels) {
-  for (int bz = 0; bz < nb.z; ++bz)
-    for (int by = 0; by < nb.y; ++by) {
-      const size_t brickRow = size_t(nb.x) * (size_t(by) + size_t(nb.y) * size_t(bz));
-      for (int bx = 0; bx < nb.x;) {
-        if (!flags[brickRow + size_t(bx)]) {
-          ++bx;
-          continue;
-        }
-        int end = bx + 1;
-        while (end < nb.x && flags[brickRow + size_t(end)]) ++end;
-        const int x0 = bx * kBrick, x1 = std::min(d.x, end * kBrick);
-        for (int k = bz * kBrick; k < std::min(d.z, (bz + 1) * kBrick); ++k)
-          for (int j = by * kBrick; j < std::min(d.y, (by + 1) * kBrick); ++j) {
-            spans.push_back({int64_t(j) + int64_t(d.y) * k, x0, x1});
-            voxels += x1 - x0;
-          }
-        bx = end;
-      }
-    }
-}
-
-// The band, and its halo: the active bricks and their 26 neighbours, which the stencils of the
-// band's voxels reach into (two voxels at most).
-struct BandWithHalo {
-  Band band, halo;
-};
-
-BandWithHalo narrowBand(const Field3D& phi, const Field3D* phi0, float halfWidthVoxels) {
-  const glm::ivec3 d = phi.grid().dims;
-  const glm::ivec3 nb = (d + glm::ivec3(kBrick - 1)) / kBrick;
-  const std::vector<float> minAbs = brickDistances(phi, phi0, nb);
-  const float limit = halfWidthVoxels * phi.grid().minSpacing();
-  std::vector<uint8_t> active(minAbs.size()), near(minAbs.size());
-  for (size_t b = 0; b < minAbs.size(); ++b) active[b] = minAbs[b] <= limit;
-  for (int bz = 0; bz < nb.z; ++bz)
-    for (int by = 0; by < nb.y; ++by)
-      for (int bx = 0; bx < nb.x; ++bx) {
-        if (!active[size_t(bx) + size_t(nb.x) * (size_t(by) + size_t(nb.y) * size_t(bz))]) continue;
-        for (int z = std::max(bz - 1, 0); z <= std::min(bz + 1, nb.z - 1); ++z)
-          for (int y = std::max(by - 1, 0); y <= std::min(by + 1, nb.y - 1); ++y)
-            for (int x = std::max(bx - 1, 0); x <= std::min(bx + 1, nb.x - 1); ++x)
-              near[size_t(x) + size_t(nb.x) * (size_t(y) + size_t(nb.y) * size_t(z))] = 1;
-      }
-  BandWithHalo out;
-  appendSpans(active, nb, d, out.band.spans, out.band.voxels);
-  appendSpans(near, nb, d, out.halo.spans, out.halo.voxels);
-  return out;
-}
+using Band = SpanList;
 
 // to = from over the spans.
 void copySpans(const Field3D& from, Field3D& to, const Band& spans) {
@@ -395,7 +300,7 @@ double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& g
 
 LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
                                const DeviceBitMask* mask, const LevelSetSettings& s,
-                               Field3D& scratch) {
+                               Field3D& scratch, NarrowBand* band) {
   requireSameGrid(phi, phi, "phi");
   requireSameGrid(phi, phi0, "the base SDF phi0");
   requireSameGrid(phi, ghat, "ghat");
@@ -410,30 +315,41 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   // The band path: the spans of active bricks, fixed for this call. Scratch starts as a copy of
   // phi over the band's halo (as far as the stencils reach) and only the band is written, so the
   // stencils at the spans' edges read the same values whichever buffer is the source.
-  BandWithHalo narrow;
-  const Band& band = narrow.band;
+  NarrowBand own;
+  NarrowBand& narrow = band ? *band : own;
   const bool banded = useBand(s) && s.substeps > 0;
   if (banded) {
-    narrow = narrowBand(phi, &phi0, s.band);
-    stats.bandVoxels = band.voxels;
-    copySpans(phi, scratch, narrow.halo);
-    stats.timeStep = timeStepFrom(stepBoundsWithin(ghat, band), ghat.grid(), s);
+    // Without the return term (lambda = 0) phi0 and the region the surface swept need no band.
+    // A new band also takes the bricks its faces claim (NarrowBand::refresh).
+    if (!narrow.builtFor(phi, s.band)) {
+      narrow.build(phi, s.lambda > 0.f ? &phi0 : nullptr, s.band);
+      narrow.refresh(phi);
+    }
+    stats.bandVoxels = narrow.band().voxels;
+    copySpans(phi, scratch, narrow.halo());
+    stats.timeStep = timeStepFrom(stepBoundsWithin(ghat, narrow.band()), ghat.grid(), s);
   } else {
     stats.timeStep = levelSetTimeStep(ghat, s);
   }
   Field3D* from = &phi;
   Field3D* to = &scratch;
   for (int n = 0; n < s.substeps; ++n) {
-    const ChangeSums c =
-        substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to, banded ? &band : nullptr);
+    const ChangeSums c = substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to,
+                                 banded ? &narrow.band() : nullptr);
     stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
+    stats.insideRise = std::max(stats.insideRise, double(c.insideRiseMax));
     stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
     stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
     std::swap(from, to);
   }
-  if (from != &phi) copyResult(*from, phi, banded ? &band : nullptr);
+  if (from != &phi) copyResult(*from, phi, banded ? &narrow.band() : nullptr);
+  if (!banded) {
+    stats.hasInterface = hasInterface(phi);
+    return stats;
+  }
   // Outside the band's halo phi did not change and lies farther than the band from the surface.
-  stats.hasInterface = banded ? interfaceWithin(phi, narrow.halo) : hasInterface(phi);
+  stats.hasInterface = interfaceWithin(phi, narrow.halo());
+  narrow.refresh(phi);
   return stats;
 }
 
@@ -450,7 +366,7 @@ bool hasInterface(const Field3D& phi) {
 }
 
 RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
-                           const Field3D* base, float stopBand) {
+                           const Field3D* base, float stopBand, NarrowBand* band) {
   requireSameGrid(phi, phi, "phi");
   if (base) requireSameGrid(phi, *base, "the base SDF");
   checkOrder(s);
@@ -458,25 +374,30 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
   RedistanceStats stats;
   // The band path as in levelSetStep: spans fixed for the call, scratch a copy of phi over the
   // band's halo. A surface lies within the band, so the band answers whether there is one.
-  BandWithHalo narrowed;
-  const Band& narrow = narrowed.band;
+  NarrowBand own;
+  NarrowBand& narrow = band ? *band : own;
   const bool banded = useBand(s) && s.redistanceIterations > 0;
-  if (banded) narrowed = narrowBand(phi, base, s.band);
-  const bool surface = banded ? interfaceWithin(phi, narrowed.halo) : hasInterface(phi);
+  // A band built by the step serves as it is (with phi0 when the return term is on).
+  if (banded && !narrow.builtFor(phi, s.band)) {
+    narrow.build(phi, base, s.band);
+    narrow.refresh(phi);
+  }
+  const bool surface = banded ? interfaceWithin(phi, narrow.halo()) : hasInterface(phi);
   if (!surface) {
     stats.converged = true;
     return stats;
   }
   if (banded) {
-    stats.bandVoxels = narrow.voxels;
-    copySpans(phi, scratch, narrowed.halo);
+    stats.bandVoxels = narrow.band().voxels;
+    copySpans(phi, scratch, narrow.halo());
   }
   Field3D* from = &phi;
   Field3D* to = &scratch;
   for (int n = 0; n < s.redistanceIterations; ++n) {
     // The first pass also sets the interface band to its subcell distance (kept afterwards).
-    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder, base,
-                                             std::max(stopBand, 0.f), banded ? &narrow : nullptr);
+    stats.meanSquaredChange =
+        redistancePass(*from, *to, n == 0, s.spatialOrder, base, std::max(stopBand, 0.f),
+                       banded ? &narrow.band() : nullptr);
     stats.iterations = n + 1;
     std::swap(from, to);
     if (stats.meanSquaredChange < double(s.redistanceTolerance)) {
@@ -484,7 +405,8 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
       break;
     }
   }
-  if (from != &phi) copyResult(*from, phi, banded ? &narrow : nullptr);
+  if (from != &phi) copyResult(*from, phi, banded ? &narrow.band() : nullptr);
+  if (banded) narrow.refresh(phi);
   return stats;
 }
 

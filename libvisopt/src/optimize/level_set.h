@@ -12,6 +12,7 @@ namespace visopt {
 
 class MemoryLedger;
 class DeviceBitMask;
+class NarrowBand;
 
 // s.substeps explicit Euler substeps of Eq. 23 on phi (in place; `scratch` is the second
 // buffer, (re)allocated like phi when it does not match phi's grid and precision). Each
@@ -19,9 +20,12 @@ class DeviceBitMask;
 // dx the smallest spacing; terms whose maximum is 0 drop out, and dt is at most s.cfl x dx^2
 // (world units) when all of them do. s.cfl is clamped to (0, 1]. `mask` (nullable; a set bit =
 // masked) turns the occlusion term off. phi0, ghat and mask must be on phi's grid.
+// On the band path (LevelSetSettings::band > 0, CPU backend) `band` (nullable) is the surface's
+// narrow band kept between calls (built on first use, moved with the surface after the step);
+// without one each call finds the band by a pass over the whole grid.
 LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
                                const DeviceBitMask* mask, const LevelSetSettings& s,
-                               Field3D& scratch);
+                               Field3D& scratch, NarrowBand* band = nullptr);
 
 // The stable dt levelSetStep would use (the same formula), for tests and callers.
 double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s);
@@ -41,8 +45,10 @@ bool hasInterface(const Field3D& phi);
 // loop needs the distance: over the whole box, regions far from every surface that are still
 // converging (a region a surface left) hold every call to its iteration cap.
 inline constexpr float kRedistanceKeepsBaseWithin = 0.05f;
+// `band` as for levelSetStep (one built there with phi0 serves a call without `base`).
 RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
-                           const Field3D* base = nullptr, float stopBand = 0.f);
+                           const Field3D* base = nullptr, float stopBand = 0.f,
+                           NarrowBand* band = nullptr);
 
 // Single passes, for the benchmark: one Euler substep of Eq. 23 with a given dt from `phi`
 // into `out` (returns max |delta phi|), and one redistancing iteration from `in` into `out`

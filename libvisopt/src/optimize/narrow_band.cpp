@@ -1,0 +1,202 @@
+#include "optimize/narrow_band.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <tbb/parallel_for.h>
+
+#include "core/field_view.h"
+#include "visopt/field.h"
+
+namespace visopt {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+size_t brickIndex(glm::ivec3 b, glm::ivec3 nb) {
+  return size_t(b.x) + size_t(nb.x) * (size_t(b.y) + size_t(nb.y) * size_t(b.z));
+}
+glm::ivec3 brickCoords(size_t index, glm::ivec3 nb) {
+  return {int(index % size_t(nb.x)), int((index / size_t(nb.x)) % size_t(nb.y)),
+          int(index / (size_t(nb.x) * size_t(nb.y)))};
+}
+
+// The band distance of one voxel: min(|phi|, |phi0|), 0 where the two differ in sign.
+float bandDistance(float a, float b) {
+  return (a < 0.f) != (b < 0.f) ? 0.f : std::min(std::fabs(a), std::fabs(b));
+}
+
+// Faces of a brick: 2 axis + side (0 low, 1 high).
+struct BrickScan {
+  float distance = kInf;  // smallest band distance over the brick's voxels
+  float face[6] = {kInf, kInf, kInf, kInf, kInf, kInf};  // smallest |phi| on each face
+};
+
+BrickScan scanBrick(const FieldView& phi, const FieldView& phi0, glm::ivec3 b, glm::ivec3 d) {
+  BrickScan s;
+  const glm::ivec3 lo = b * kBrick, hi = glm::min(lo + kBrick, d);
+  for (int k = lo.z; k < hi.z; ++k)
+    for (int j = lo.y; j < hi.y; ++j) {
+      const size_t row = size_t(d.x) * (size_t(j) + size_t(d.y) * size_t(k));
+      float rowMin = kInf;
+      for (int i = lo.x; i < hi.x; ++i) {
+        const float a = phi.load(row + size_t(i));
+        const float base = phi0.valid() ? phi0.load(row + size_t(i)) : a;
+        s.distance = std::min(s.distance, bandDistance(a, base));
+        rowMin = std::min(rowMin, std::fabs(a));
+      }
+      s.face[0] = std::min(s.face[0], std::fabs(phi.load(row + size_t(lo.x))));
+      s.face[1] = std::min(s.face[1], std::fabs(phi.load(row + size_t(hi.x - 1))));
+      if (j == lo.y) s.face[2] = std::min(s.face[2], rowMin);
+      if (j == hi.y - 1) s.face[3] = std::min(s.face[3], rowMin);
+      if (k == lo.z) s.face[4] = std::min(s.face[4], rowMin);
+      if (k == hi.z - 1) s.face[5] = std::min(s.face[5], rowMin);
+    }
+  return s;
+}
+
+// Bounds the values of brick `b` by the distances on the face of its neighbour `from` that they
+// share: |phi(y)| <= |phi(x)| + |y - x| for x the face voxel on y's line across the face.
+void boundFromFace(const FieldView& phi, glm::ivec3 b, glm::ivec3 from, glm::ivec3 d,
+                   glm::vec3 spacing) {
+  const glm::ivec3 lo = b * kBrick, hi = glm::min(lo + kBrick, d);
+  const glm::ivec3 step = b - from;  // one axis is +-1
+  const int axis = step.x != 0 ? 0 : (step.y != 0 ? 1 : 2);
+  const int face = step[axis] > 0 ? lo[axis] - 1 : hi[axis];  // the claimant's face voxel
+  for (int k = lo.z; k < hi.z; ++k)
+    for (int j = lo.y; j < hi.y; ++j)
+      for (int i = lo.x; i < hi.x; ++i) {
+        glm::ivec3 x(i, j, k);
+        const float reach = float(std::abs(x[axis] - face)) * spacing[axis];
+        x[axis] = face;
+        const float bound = std::fabs(phi.at(x.x, x.y, x.z)) + reach;
+        const size_t v = phi.index(i, j, k);
+        const float value = phi.load(v);
+        if (std::fabs(value) > bound) phi.store(v, value < 0.f ? -bound : bound);
+      }
+}
+
+void appendSpans(const std::vector<uint8_t>& flags, glm::ivec3 nb, glm::ivec3 d, SpanList& out) {
+  out.spans.clear();
+  out.voxels = 0;
+  for (int bz = 0; bz < nb.z; ++bz)
+    for (int by = 0; by < nb.y; ++by) {
+      const size_t brickRow = brickIndex({0, by, bz}, nb);
+      for (int bx = 0; bx < nb.x;) {
+        if (!flags[brickRow + size_t(bx)]) {
+          ++bx;
+          continue;
+        }
+        int end = bx + 1;
+        while (end < nb.x && flags[brickRow + size_t(end)]) ++end;
+        const int x0 = bx * kBrick, x1 = std::min(d.x, end * kBrick);
+        for (int k = bz * kBrick; k < std::min(d.z, (bz + 1) * kBrick); ++k)
+          for (int j = by * kBrick; j < std::min(d.y, (by + 1) * kBrick); ++j) {
+            out.spans.push_back({int64_t(j) + int64_t(d.y) * k, x0, x1});
+            out.voxels += x1 - x0;
+          }
+        bx = end;
+      }
+    }
+}
+
+}  // namespace
+
+void NarrowBand::build(const Field3D& phi, const Field3D* phi0, float halfWidthVoxels) {
+  clear();
+  dims_ = phi.grid().dims;
+  nb_ = (dims_ + glm::ivec3(kBrick - 1)) / kBrick;
+  phiData_ = phi.raw();
+  phi0_ = phi0;
+  halfWidthVoxels_ = halfWidthVoxels;
+  h_ = phi.grid().minSpacing();
+  const float limit = halfWidthVoxels * h_;
+  flags_.assign(size_t(nb_.x) * size_t(nb_.y) * size_t(nb_.z), 0);
+  const FieldView p(phi);
+  const FieldView base = phi0 ? FieldView(*phi0) : FieldView();
+  const glm::ivec3 d = dims_, nb = nb_;
+  uint8_t* flags = flags_.data();
+  tbb::parallel_for(size_t(0), flags_.size(), [&](size_t b) {
+    flags[b] = scanBrick(p, base, brickCoords(b, nb), d).distance <= limit;
+  });
+  for (size_t b = 0; b < flags_.size(); ++b)
+    if (flags_[b]) active_.push_back(int32_t(b));
+  rebuildSpans();
+}
+
+bool NarrowBand::builtFor(const Field3D& phi, float halfWidthVoxels) const {
+  return !flags_.empty() && phi.raw() == phiData_ && phi.grid().dims == dims_ &&
+         halfWidthVoxels == halfWidthVoxels_;
+}
+
+void NarrowBand::refresh(Field3D& phi) {
+  lastActivated_ = lastReleased_ = 0;
+  if (flags_.empty()) return;
+  const FieldView p(phi);
+  const FieldView base = phi0_ ? FieldView(*phi0_) : FieldView();
+  const glm::ivec3 d = dims_, nb = nb_;
+  const glm::vec3 spacing = phi.grid().spacing;
+  const float limit = halfWidthVoxels_ * h_;
+  const float release = (halfWidthVoxels_ + kReleaseMarginVoxels) * h_;
+
+  // The active bricks' distances and face minima (only they can have changed).
+  std::vector<BrickScan> scans(active_.size());
+  tbb::parallel_for(size_t(0), active_.size(), [&](size_t a) {
+    scans[a] = scanBrick(p, base, brickCoords(size_t(active_[a]), nb), d);
+  });
+
+  // Claims across faces whose voxels lie within limit + one voxel of the surface.
+  std::vector<uint8_t> claimed(flags_.size(), 0);
+  struct Claim {
+    int32_t brick, from;
+  };
+  std::vector<Claim> newcomers;
+  for (size_t a = 0; a < active_.size(); ++a) {
+    const glm::ivec3 b = brickCoords(size_t(active_[a]), nb);
+    for (int f = 0; f < 6; ++f) {
+      const int axis = f / 2;
+      glm::ivec3 n = b;
+      n[axis] += (f % 2) ? 1 : -1;
+      if (n[axis] < 0 || n[axis] >= nb[axis]) continue;
+      if (scans[a].face[f] - spacing[axis] > limit) continue;
+      const size_t ni = brickIndex(n, nb);
+      claimed[ni] = 1;
+      if (!flags_[ni]) newcomers.push_back({int32_t(ni), active_[a]});
+    }
+  }
+  for (size_t a = 0; a < active_.size(); ++a) {
+    const size_t b = size_t(active_[a]);
+    if (scans[a].distance > release && !claimed[b]) {
+      flags_[b] = 0;
+      ++lastReleased_;
+    }
+  }
+  // Newcomers: values bounded by their claimants' faces (serial: a few bricks per refresh).
+  for (const Claim& c : newcomers) {
+    boundFromFace(p, brickCoords(size_t(c.brick), nb), brickCoords(size_t(c.from), nb), d, spacing);
+    if (!flags_[size_t(c.brick)]) ++lastActivated_;
+    flags_[size_t(c.brick)] = 1;
+  }
+  if (lastActivated_ == 0 && lastReleased_ == 0) return;
+  active_.clear();
+  for (size_t b = 0; b < flags_.size(); ++b)
+    if (flags_[b]) active_.push_back(int32_t(b));
+  rebuildSpans();
+}
+
+void NarrowBand::rebuildSpans() {
+  std::vector<uint8_t> near(flags_.size(), 0);
+  for (const int32_t a : active_) {
+    const glm::ivec3 b = brickCoords(size_t(a), nb_);
+    for (int z = std::max(b.z - 1, 0); z <= std::min(b.z + 1, nb_.z - 1); ++z)
+      for (int y = std::max(b.y - 1, 0); y <= std::min(b.y + 1, nb_.y - 1); ++y)
+        for (int x = std::max(b.x - 1, 0); x <= std::min(b.x + 1, nb_.x - 1); ++x)
+          near[brickIndex({x, y, z}, nb_)] = 1;
+  }
+  appendSpans(flags_, nb_, dims_, band_);
+  appendSpans(near, nb_, dims_, halo_);
+}
+
+}  // namespace visopt

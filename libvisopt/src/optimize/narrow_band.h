@@ -1,0 +1,87 @@
+// The narrow band of one context surface (issue 11): bricks of kBrick^3 voxels of the volume grid
+// that the level-set step (Eq. 23) and redistancing (Eq. 18) update, kept from call to call and
+// moved with the surface instead of being found again by a pass over the whole grid.
+//
+// A brick is active when one of its voxels lies within the band's half-width of the surface
+// (|phi|) or of its base shape (|phi0|), or where the two differ in sign (the region the surface
+// swept, where the return term of Eq. 23 can flip the sign back; left out, a surface relaxing from
+// far away would leave its old inside behind as a spurious one). The storage of phi is dense: an
+// inactive brick keeps the values it had when it left the band (or the base SDF's), of which only
+// the sign is read.
+//
+// Following the surface: the kernels write only active bricks, so an inactive brick's values
+// never change by themselves and cannot say that the surface came near. The active bricks' faces
+// say it instead: when a face's voxels come within half-width + 1 voxel of the surface, the
+// brick across that face may hold a voxel within the half-width and is activated, its values
+// bounded by the face's distances plus the distance to the face (a distance function is
+// 1-Lipschitz; stale values from long ago can be far too large). A brick leaves the band once all
+// its voxels are farther than half-width + kReleaseMarginVoxels (hysteresis: a surface
+// oscillating about a brick's edge does not switch it on and off) and no active neighbour's face
+// claims it.
+//
+// Host data: the band path runs on the CPU backend.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace visopt {
+
+class Field3D;
+
+inline constexpr int kBrick = 8;
+
+// Voxels [x0, x1) of the x row `row` (= j + dims.y * k).
+struct RowSpan {
+  int64_t row;
+  int x0, x1;
+};
+
+// Runs of bricks along x, one span per voxel row.
+struct SpanList {
+  std::vector<RowSpan> spans;
+  int64_t voxels = 0;
+};
+
+class NarrowBand {
+ public:
+  static constexpr float kReleaseMarginVoxels = 2.f;
+
+  // From phi and phi0 (nullable): every brick's distance, a pass over the whole grid.
+  void build(const Field3D& phi, const Field3D* phi0, float halfWidthVoxels);
+  // True when built for phi (its storage and grid) and this half-width, from any base.
+  bool builtFor(const Field3D& phi, float halfWidthVoxels) const;
+  // After phi changed inside the active bricks only: their distances again (reading those bricks
+  // only), neighbours activated across faces near the surface, bricks far from it released.
+  void refresh(Field3D& phi);
+  void clear() { *this = NarrowBand(); }
+
+  bool empty() const { return active_.empty(); }
+  const Field3D* base() const { return phi0_; }
+  // The active bricks as spans, and their halo (the active bricks and their 26 neighbours,
+  // which the stencils of the active voxels reach into: two voxels at most).
+  const SpanList& band() const { return band_; }
+  const SpanList& halo() const { return halo_; }
+  int64_t activeBricks() const { return int64_t(active_.size()); }
+  int64_t bricks() const { return int64_t(flags_.size()); }
+  // Bricks that the last refresh activated and released.
+  int64_t lastActivated() const { return lastActivated_; }
+  int64_t lastReleased() const { return lastReleased_; }
+
+ private:
+  void rebuildSpans();
+
+  glm::ivec3 dims_{0}, nb_{0};
+  const void* phiData_ = nullptr;
+  const Field3D* phi0_ = nullptr;
+  float halfWidthVoxels_ = 0.f;
+  float h_ = 1.f;                // the grid's smallest spacing
+  std::vector<uint8_t> flags_;   // per brick (x fastest): 1 = active
+  std::vector<int32_t> active_;  // the active bricks' indices, ascending
+  SpanList band_, halo_;
+  int64_t lastActivated_ = 0, lastReleased_ = 0;
+};
+
+}  // namespace visopt

@@ -1,6 +1,6 @@
-// The level-set step's vectorised CPU row loop (kernels/level_set_step.h, sweepStepRow) against
-// the per-voxel path the CUDA backend runs (sweepVoxel), and the integer fp16 conversions that
-// row loop uses against the reference conversions of core/half.h.
+// The vectorised CPU row loop (kernels/level_set_step.h, sweepStepRow) of the level-set step and
+// of redistancing against the per-voxel path the CUDA backend runs (sweepVoxel), and the integer
+// fp16 conversions that row loop uses against the reference conversions of core/half.h.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -13,6 +13,7 @@
 #include "core/device_bit_mask.h"
 #include "core/half.h"
 #include "kernels/level_set_step.h"
+#include "kernels/redistance.h"
 
 using namespace visopt;
 
@@ -178,4 +179,103 @@ TEST(LevelSetRows, RowLoopMatchesThePerVoxelPath) {
                        << " order " << order << (withMask ? " masked" : ""));
           compare(Case{dims, fp16, withMask, order});
         }
+}
+
+namespace {
+
+// Redistancing (kernels/redistance.h) through sweepStepRow, whole rows and spans of rows (the
+// band path), against sweepVoxel: the first pass (subcell initialisation) and a later one, with
+// and without a base SDF whose nearby voxels are held.
+template <class A, int Order>
+void compareRedistanceRowsWithVoxels(glm::ivec3 dims, bool initialise, bool withBase) {
+  using Store = std::conditional_t<std::is_same_v<A, Fp16Access>, Half, float>;
+  const size_t n = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> noise(-0.4f, 0.4f);
+  auto store = [](float v) {
+    if constexpr (std::is_same_v<Store, Half>)
+      return floatToHalf(v);
+    else
+      return v;
+  };
+  auto load = [](Store v) {
+    if constexpr (std::is_same_v<Store, Half>)
+      return halfToFloat(v);
+    else
+      return v;
+  };
+  std::vector<Store> in(n), base(n), outRows(n), outVoxels(n), outSpans(n);
+  const glm::vec3 centre = glm::vec3(dims) * 0.5f + glm::vec3(0.2f, -0.3f, 0.15f);
+  const float radius = 0.3f * float(std::min({dims.x, dims.y, dims.z}));
+  for (int k = 0; k < dims.z; ++k)
+    for (int j = 0; j < dims.y; ++j)
+      for (int i = 0; i < dims.x; ++i) {
+        const size_t v = (size_t(k) * size_t(dims.y) + size_t(j)) * size_t(dims.x) + size_t(i);
+        const float d = glm::length(glm::vec3(i, j, k) - centre) - radius;
+        base[v] = store(d);
+        // Half the voxels keep their base value (held when withBase), the rest are distorted.
+        in[v] = store((v % 2) ? d : d * (1.3f + noise(rng)));
+      }
+  RedistanceKernel<A, Order> k;
+  k.in = A{in.data()};
+  k.dims = dims;
+  k.spacing = glm::vec3(1.f, 1.3f, 0.7f);
+  k.dxMin = 0.7f;
+  k.dtau = 0.3f * k.dxMin;
+  k.initialise = initialise;
+  if (withBase) {
+    k.base = A{base.data()};
+    k.hasBase = true;
+    k.keepWithin = 0.05f * k.dxMin;
+  }
+  k.nearBand = 2.f * k.dxMin;
+  k.out = A{outVoxels.data()};
+  ChangeSums voxels;
+  for (int64_t v = 0; v < int64_t(n); ++v) voxels = voxels + k.voxel(v);
+  k.out = A{outRows.data()};
+  ChangeSums rows;
+  for (int64_t r = 0; r < int64_t(dims.y) * dims.z; ++r) rows = rows + k.row(r);
+  // Spans [3, nx - 5) and the rest of each row, as the band path splits rows.
+  k.out = A{outSpans.data()};
+  ChangeSums spans;
+  const int cut0 = std::min(3, dims.x), cut1 = std::max(cut0, dims.x - 5);
+  for (int64_t r = 0; r < int64_t(dims.y) * dims.z; ++r)
+    spans = spans + k.span(r, 0, cut0) + k.span(r, cut0, cut1) + k.span(r, cut1, dims.x);
+  size_t differ = 0;
+  const float ulps = std::is_same_v<Store, Half> ? 1e-3f : 1e-6f;
+  for (size_t v = 0; v < n; ++v) {
+    const float a = load(outRows[v]), b = load(outVoxels[v]), c = load(outSpans[v]);
+    ASSERT_TRUE(std::isfinite(a)) << v;
+    ASSERT_NEAR(a, b, ulps * std::max(1.f, std::fabs(b))) << "voxel " << v;
+    ASSERT_NEAR(c, b, ulps * std::max(1.f, std::fabs(b))) << "voxel " << v;
+    differ += a != b;
+  }
+  std::printf("redistance %dx%dx%d %s order %d%s%s: %zu of %zu voxels differ in the last bits\n",
+              dims.x, dims.y, dims.z, std::is_same_v<Store, Half> ? "fp16" : "fp32", Order,
+              initialise ? " first pass" : "", withBase ? " with base" : "", differ, n);
+  const double rel = std::is_same_v<Store, Half> ? 1e-3 : 1e-5;
+  for (const ChangeSums* s : {&rows, &spans}) {
+    EXPECT_NEAR(s->maxAbs, voxels.maxAbs, rel * std::max(1.f, voxels.maxAbs));
+    EXPECT_NEAR(s->sumSquared, voxels.sumSquared, rel * std::max(1.0, voxels.sumSquared));
+    EXPECT_NEAR(s->nearSumSquared, voxels.nearSumSquared,
+                rel * std::max(1.0, voxels.nearSumSquared));
+    EXPECT_EQ(s->nearCount, voxels.nearCount);
+  }
+  EXPECT_GT(voxels.sumAbs, 0.0) << "the pass moved something";
+}
+
+}  // namespace
+
+TEST(RedistanceRows, RowLoopMatchesThePerVoxelPath) {
+  for (glm::ivec3 dims :
+       {glm::ivec3(37, 9, 7), glm::ivec3(20, 6, 5), glm::ivec3(11, 5, 6), glm::ivec3(37, 1, 3)})
+    for (bool initialise : {true, false})
+      for (bool withBase : {false, true}) {
+        SCOPED_TRACE(testing::Message()
+                     << dims.x << "x" << dims.y << "x" << dims.z << (initialise ? " first" : "")
+                     << (withBase ? " base" : ""));
+        compareRedistanceRowsWithVoxels<Fp32Access, 2>(dims, initialise, withBase);
+        compareRedistanceRowsWithVoxels<Fp32Access, 1>(dims, initialise, withBase);
+        compareRedistanceRowsWithVoxels<Fp16Access, 2>(dims, initialise, withBase);
+      }
 }

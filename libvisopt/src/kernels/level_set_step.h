@@ -268,10 +268,10 @@ struct ChangeSums {
 //
 // A stencil kernel K provides dims, spacing, current(v) (the value it replaces), next(v, ax, ay,
 // az) (the new value, branch-free), write(v, value) and kept(value) (what storage keeps).
-// sweepVoxel runs one voxel (the CUDA path); sweepRow one x row (the CPU path): the y/z stencil
-// is fixed along a row, the two voxels at either end use the border stencil, and the interior
-// runs in chunks of kLanes with a fixed x stencil and per-lane accumulators, so that the
-// compiler can vectorise it.
+// sweepVoxel runs one voxel (the CUDA path); sweepStepRow (below) one x row or span of a row
+// (the CPU path): the y/z stencil is fixed along a row, the two voxels at either end use the
+// border stencil, and the interior runs in chunks of kLanes with a fixed x stencil and per-lane
+// accumulators, so that the compiler can vectorise it.
 
 // The first voxel of span [x0, x1) at least two voxels from the row's start, and the end of the
 // voxels at least two from the row's end (never before `lo`).
@@ -296,66 +296,6 @@ VISOPT_HD ChangeSums sweepVoxel(const K& k, int64_t v) {
   k.write(size_t(v), next);
   ChangeSums sums;
   sums.add(k.kept(next) - c, c, k.nearBand);
-  return sums;
-}
-
-template <class K>
-VISOPT_HD ChangeSums sweepRow(const K& k, int64_t r, int x0 = 0, int x1 = -1) {
-  constexpr int kLanes = 16;
-  const int nx = k.dims.x;
-  if (x1 < 0) x1 = nx;
-  const int64_t ny = k.dims.y;
-  const StencilAxis ay = stencilAxis(int(r % ny), k.dims.y, nx, k.spacing.y);
-  const StencilAxis az = stencilAxis(int(r / ny), k.dims.z, int64_t(nx) * ny, k.spacing.z);
-  const StencilAxis inner = stencilAxis(2, 5, 1, k.spacing.x);  // no border within reach
-  const size_t base = size_t(r) * size_t(nx);
-  ChangeSums sums;
-  auto single = [&](int i, const StencilAxis& ax) {
-    const size_t v = base + size_t(i);
-    const float c = k.current(v);
-    const float next = k.next(v, ax, ay, az);
-    k.write(v, next);
-    sums.add(k.kept(next) - c, c, k.nearBand);
-  };
-  // [lo, hi): the span's voxels at least two from the row's ends (no x border within reach).
-  const int lo = spanInteriorBegin(x0, x1, nx);
-  const int hi = spanInteriorEnd(x1, nx, lo);
-  for (int i = x0; i < lo; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
-  float maxAbs[kLanes], sumAbs[kLanes], sumSquared[kLanes], nearMaxAbs[kLanes],
-      nearSumSquared[kLanes], nearCount[kLanes], insideRiseMax[kLanes];
-  for (int l = 0; l < kLanes; ++l)
-    maxAbs[l] = sumAbs[l] = sumSquared[l] = nearMaxAbs[l] = nearSumSquared[l] = nearCount[l] =
-        insideRiseMax[l] = 0.f;
-  int i = lo;
-  for (; i + kLanes <= hi; i += kLanes) {
-    const size_t v0 = base + size_t(i);
-    for (int l = 0; l < kLanes; ++l) {
-      const size_t v = v0 + size_t(l);
-      const float c = k.current(v);
-      const float next = k.next(v, inner, ay, az);
-      k.write(v, next);
-      const float d = k.kept(next) - c;
-      maxAbs[l] = maxOf(maxAbs[l], fabsf(d));
-      sumAbs[l] += fabsf(d);
-      sumSquared[l] += d * d;
-      const bool near = fabsf(c) <= k.nearBand;
-      nearMaxAbs[l] = maxOf(nearMaxAbs[l], near ? fabsf(d) * surfaceShare(c, k.nearBand) : 0.f);
-      nearSumSquared[l] += near ? d * d : 0.f;
-      nearCount[l] += near ? 1.f : 0.f;
-      insideRiseMax[l] = maxOf(insideRiseMax[l], c < -k.nearBand ? maxOf(d, 0.f) : 0.f);
-    }
-  }
-  for (; i < hi; ++i) single(i, inner);
-  for (; i < x1; ++i) single(i, stencilAxis(i, nx, 1, k.spacing.x));
-  for (int l = 0; l < kLanes; ++l) {
-    sums.maxAbs = maxOf(sums.maxAbs, maxAbs[l]);
-    sums.sumAbs += double(sumAbs[l]);
-    sums.sumSquared += double(sumSquared[l]);
-    sums.nearMaxAbs = maxOf(sums.nearMaxAbs, nearMaxAbs[l]);
-    sums.nearSumSquared += double(nearSumSquared[l]);
-    sums.nearCount += double(nearCount[l]);
-    sums.insideRiseMax = maxOf(sums.insideRiseMax, insideRiseMax[l]);
-  }
   return sums;
 }
 

@@ -48,7 +48,8 @@ VISOPT_HD VISOPT_INLINE bool nextToInterface(float c, float xm, float xp, float 
 // from it, as if the face were a surface (a face voxel stayed at 1.08 voxels where the
 // distance was 16.9). Without inflow, a face value too small (|grad phi| < 1 seen from the
 // interior) grows until it is one voxel's distance beyond its neighbour's.
-VISOPT_HD VISOPT_INLINE OneSided inflowOnly(OneSided d, const StencilAxis& a) {
+template <class Ax>
+VISOPT_HD VISOPT_INLINE OneSided inflowOnly(OneSided d, const Ax& a) {
   if (a.lo) d.dm = 0.f;
   if (a.hi) d.dp = 0.f;
   return d;
@@ -73,8 +74,18 @@ struct RedistanceKernel {
   VISOPT_HD VISOPT_INLINE void write(size_t v, float x) const { out.store(v, x); }
   VISOPT_HD VISOPT_INLINE float kept(float x) const { return out.kept(x); }
 
+  // Nothing is masked in redistancing; masked(v) and nextAt let sweepStepRow run the kernel:
+  // rows two voxels or more from the y and z faces use InnerAxis (no border selects), which took
+  // a second-order pass at 256^3 from 275 to 147 ms (docs/level-set-benchmarks.md). The loop
+  // still compiles to scalar code (g++: "control flow in loop").
+  VISOPT_HD VISOPT_INLINE bool masked(size_t) const { return false; }
   VISOPT_HD VISOPT_INLINE float next(size_t v, const StencilAxis& ax, const StencilAxis& ay,
                                      const StencilAxis& az) const {
+    return nextAt(v, false, ax, ay, az);
+  }
+  template <class AX, class AY, class AZ>
+  VISOPT_HD VISOPT_INLINE float nextAt(size_t v, bool, const AX& ax, const AY& ay,
+                                       const AZ& az) const {
     const int64_t s = int64_t(v);
     const float c = in.load(v);
     const float xm = in.load(size_t(s + ax.m)), xp = in.load(size_t(s + ax.p));
@@ -115,13 +126,18 @@ struct RedistanceKernel {
     // average within a voxel of the surface, the Sussman steady state of another scheme), which
     // the return term of Eq. 23 then pulled back: voxel-scale dimples in the shading all over
     // a surface the optimisation never meant to move. Such voxels are held like the band.
-    if (hasBase && fabsf(c - base.load(v)) <= keepWithin) return c;
-    return band ? bandValue : limited;
+    // Without a base the field itself stands in (a loop-invariant choice of pointer, not a
+    // conditional load) and nothing is held.
+    const float b = (hasBase ? base : in).load(v);
+    const bool held = fabsf(c - b) <= (hasBase ? keepWithin : -1.f);
+    return held ? c : (band ? bandValue : limited);
   }
 
   VISOPT_HD ChangeSums voxel(int64_t v) const { return sweepVoxel(*this, v); }
-  VISOPT_HD ChangeSums row(int64_t r) const { return sweepRow(*this, r); }
-  VISOPT_HD ChangeSums span(int64_t r, int x0, int x1) const { return sweepRow(*this, r, x0, x1); }
+  VISOPT_HD ChangeSums row(int64_t r) const { return sweepStepRow(*this, r); }
+  VISOPT_HD ChangeSums span(int64_t r, int x0, int x1) const {
+    return sweepStepRow(*this, r, x0, x1);
+  }
 };
 
 // Counts voxels next to the interface (no interface: nothing to measure distance to).

@@ -225,8 +225,9 @@ void compareRedistanceRowsWithVoxels(glm::ivec3 dims, bool initialise, bool with
   k.initialise = initialise;
   if (withBase) {
     k.base = A{base.data()};
-    k.hasBase = true;
     k.keepWithin = 0.05f * k.dxMin;
+  } else {
+    k.withoutBase();
   }
   k.nearBand = 2.f * k.dxMin;
   k.out = A{outVoxels.data()};

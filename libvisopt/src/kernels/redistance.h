@@ -37,8 +37,9 @@ namespace visopt {
 // True when phi at the voxel and one of its face neighbours have opposite signs (or one is 0).
 VISOPT_HD VISOPT_INLINE bool nextToInterface(float c, float xm, float xp, float ym, float yp,
                                              float zm, float zp) {
-  return c * xm <= 0.f || c * xp <= 0.f || c * ym <= 0.f || c * yp <= 0.f || c * zm <= 0.f ||
-         c * zp <= 0.f;
+  // | rather than ||: no branches, so that the row loops that inline it vectorise.
+  return (c * xm <= 0.f) | (c * xp <= 0.f) | (c * ym <= 0.f) | (c * yp <= 0.f) | (c * zm <= 0.f) |
+         (c * zp <= 0.f);
 }
 
 // The grid's faces let nothing in: the one-sided difference reaching past a face is 0, so
@@ -63,11 +64,15 @@ struct RedistanceKernel {
   float dtau = 0.5f;
   float dxMin = 1.f;
   bool initialise = false;  // the first pass: set the interface band to its subcell distance
-  // The surface's base SDF phi0 (Eq. 15), when given (hasBase): a voxel within keepWithin
-  // (world units) of it keeps its value (see the end of next()).
+  // The surface's base SDF phi0 (Eq. 15): a voxel within keepWithin (world units) of it keeps its
+  // value (see the end of nextAt()). Always read (a branch-free loop vectorises): without a base,
+  // withoutBase() makes it the input itself with a negative keepWithin, so nothing is held.
   A base{};
-  bool hasBase = false;
-  float keepWithin = 0.f;
+  float keepWithin = -1.f;
+  VISOPT_HD void withoutBase() {
+    base = in;
+    keepWithin = -1.f;
+  }
   float nearBand = 3.4e38f;  // ChangeSums::nearMaxAbs counts voxels with |phi| <= this
 
   VISOPT_HD VISOPT_INLINE float current(size_t v) const { return in.load(v); }
@@ -75,9 +80,8 @@ struct RedistanceKernel {
   VISOPT_HD VISOPT_INLINE float kept(float x) const { return out.kept(x); }
 
   // Nothing is masked in redistancing; masked(v) and nextAt let sweepStepRow run the kernel:
-  // rows two voxels or more from the y and z faces use InnerAxis (no border selects), which took
-  // a second-order pass at 256^3 from 275 to 147 ms (docs/level-set-benchmarks.md). The loop
-  // still compiles to scalar code (g++: "control flow in loop").
+  // rows two voxels or more from the y and z faces use InnerAxis (no border selects), and the
+  // chunks vectorise (docs/level-set-benchmarks.md).
   VISOPT_HD VISOPT_INLINE bool masked(size_t) const { return false; }
   VISOPT_HD VISOPT_INLINE float next(size_t v, const StencilAxis& ax, const StencilAxis& ay,
                                      const StencilAxis& az) const {
@@ -107,7 +111,10 @@ struct RedistanceKernel {
     // own O(h) error each time, which shows as speckles of deviation all over a surface and,
     // next to a thin wall's medial kink a voxel away, does not even settle.
     const bool distanceLike = fabsf(bandGrad - 1.f) < 0.03f;
-    const float bandValue = initialise && !distanceLike && bandGrad > 0.f ? c / bandGrad : c;
+    // (Every value is computed and then selected: a branch keeps g++ from vectorising the row
+    // loop, and so do a select between two pointers and a select of a select's result.)
+    const float estimate = c / (bandGrad > 0.f ? bandGrad : 1.f);
+    const float bandValue = (initialise & !distanceLike & (bandGrad > 0.f)) ? estimate : c;
 
     // Sussman's update elsewhere.
     const float sgn = c / sqrtf(c * c + dxMin * dxMin);
@@ -119,18 +126,16 @@ struct RedistanceKernel {
                              godunovSquared(dz, positive));
     const float moved = c - dtau * sgn * (grad - 1.f);
     // Never more than halve |phi| in one pass: the sign stays the start sign.
-    const float limited = positive ? maxOf(moved, 0.5f * c) : minOf(moved, 0.5f * c);
+    const float up = maxOf(moved, 0.5f * c), down = minOf(moved, 0.5f * c);
+    const float limited = sgn > 0.f ? up : down;
     // Where phi is still its base SDF (within keepWithin) nothing needs redistancing: phi0 is a
     // distance already, and redistancing it anew moved unmoved surfaces (the band's estimate,
     // by up to 0.45 voxel, mean 0.03, each time) and their neighbourhood (0.2 voxel on
     // average within a voxel of the surface, the Sussman steady state of another scheme), which
     // the return term of Eq. 23 then pulled back: voxel-scale dimples in the shading all over
     // a surface the optimisation never meant to move. Such voxels are held like the band.
-    // Without a base the field itself stands in (a loop-invariant choice of pointer, not a
-    // conditional load) and nothing is held.
-    const float b = (hasBase ? base : in).load(v);
-    const bool held = fabsf(c - b) <= (hasBase ? keepWithin : -1.f);
-    return held ? c : (band ? bandValue : limited);
+    const float update = band ? bandValue : limited;
+    return fabsf(c - base.load(v)) <= keepWithin ? c : update;
   }
 
   VISOPT_HD ChangeSums voxel(int64_t v) const { return sweepVoxel(*this, v); }

@@ -218,8 +218,9 @@ double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, cons
   k.out = accessOf(out, Tag<A>{});
   if (base) {
     k.base = accessOf(*base, Tag<A>{});
-    k.hasBase = true;
     k.keepWithin = kRedistanceKeepsBaseWithin * g.minSpacing();
+  } else {
+    k.withoutBase();
   }
   k.dims = g.dims;
   k.spacing = g.spacing;

@@ -31,6 +31,21 @@ float floatOf(uint32_t u) {
   return f;
 }
 
+// A test field's storage value (float or Half) from a float, and back.
+template <class Store>
+Store storeAs(float v) {
+  if constexpr (std::is_same_v<Store, Half>)
+    return floatToHalf(v);
+  else
+    return v;
+}
+float loadAs(float v) {
+  return v;
+}
+float loadAs(Half v) {
+  return halfToFloat(v);
+}
+
 }  // namespace
 
 TEST(Fp16RowConversions, EveryHalfWidensToTheSameFloat) {
@@ -88,12 +103,7 @@ void compareRowsWithVoxels(const Case& c) {
   const size_t n = size_t(c.dims.x) * size_t(c.dims.y) * size_t(c.dims.z);
   std::mt19937 rng(1234);
   std::uniform_real_distribution<float> noise(-0.3f, 0.3f), unit(0.f, 1.f);
-  auto store = [](float v) {
-    if constexpr (std::is_same_v<Store, Half>)
-      return floatToHalf(v);
-    else
-      return v;
-  };
+  const auto store = storeAs<Store>;
   std::vector<Store> phi(n), phi0(n), ghat(n), outRows(n), outVoxels(n);
   const glm::vec3 centre = glm::vec3(c.dims) * 0.5f + glm::vec3(0.3f, -0.2f, 0.1f);
   const float radius = 0.3f * float(std::min({c.dims.x, c.dims.y, c.dims.z}));
@@ -130,14 +140,7 @@ void compareRowsWithVoxels(const Case& c) {
 
   size_t differ = 0;
   for (size_t v = 0; v < n; ++v) {
-    float a, b;
-    if constexpr (std::is_same_v<Store, Half>) {
-      a = halfToFloat(outRows[v]);
-      b = halfToFloat(outVoxels[v]);
-    } else {
-      a = outRows[v];
-      b = outVoxels[v];
-    }
+    const float a = loadAs(outRows[v]), b = loadAs(outVoxels[v]);
     ASSERT_TRUE(std::isfinite(a)) << v;
     // The vector code may contract a*b+c into an FMA: a few ulps of fp32, never more, which in
     // fp16 storage can at most round to the neighbouring half.
@@ -192,18 +195,7 @@ void compareRedistanceRowsWithVoxels(glm::ivec3 dims, bool initialise, bool with
   const size_t n = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
   std::mt19937 rng(99);
   std::uniform_real_distribution<float> noise(-0.4f, 0.4f);
-  auto store = [](float v) {
-    if constexpr (std::is_same_v<Store, Half>)
-      return floatToHalf(v);
-    else
-      return v;
-  };
-  auto load = [](Store v) {
-    if constexpr (std::is_same_v<Store, Half>)
-      return halfToFloat(v);
-    else
-      return v;
-  };
+  const auto store = storeAs<Store>;
   std::vector<Store> in(n), base(n), outRows(n), outVoxels(n), outSpans(n);
   const glm::vec3 centre = glm::vec3(dims) * 0.5f + glm::vec3(0.2f, -0.3f, 0.15f);
   const float radius = 0.3f * float(std::min({dims.x, dims.y, dims.z}));
@@ -245,7 +237,7 @@ void compareRedistanceRowsWithVoxels(glm::ivec3 dims, bool initialise, bool with
   size_t differ = 0;
   const float ulps = std::is_same_v<Store, Half> ? 1e-3f : 1e-6f;
   for (size_t v = 0; v < n; ++v) {
-    const float a = load(outRows[v]), b = load(outVoxels[v]), c = load(outSpans[v]);
+    const float a = loadAs(outRows[v]), b = loadAs(outVoxels[v]), c = loadAs(outSpans[v]);
     ASSERT_TRUE(std::isfinite(a)) << v;
     ASSERT_NEAR(a, b, ulps * std::max(1.f, std::fabs(b))) << "voxel " << v;
     ASSERT_NEAR(c, b, ulps * std::max(1.f, std::fabs(b))) << "voxel " << v;

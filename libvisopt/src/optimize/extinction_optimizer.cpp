@@ -154,7 +154,7 @@ struct ExtinctionOptimizer::Level {
   float gradientScale = 1.f;
   double motionSinceRedistance = 0.0;  // bound on the surfaces' motion since the last redistancing
   int substeps = 0;                    // level-set substeps per iteration (LevelSetSettings::reach)
-  double farMotionSinceRedistance = 0.0;  // bound on the inside's rise (LevelSetStepStats)
+  double insideRiseSinceRedistance = 0.0;  // bound on the inside's rise (LevelSetStepStats)
   double lastMotion = 0.0;  // bound on how far the surfaces moved in the last iteration, world
                             // units
   double lastEnergy = 0.0;
@@ -605,19 +605,19 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   for (int done = 0; done < std::max(L.substeps, 1); done += chunkSettings.substeps) {
     chunkSettings.substeps = std::min(chunk, std::max(L.substeps, 1) - done);
     auto ts = Clock::now();
-    double motion = 0.0, farMotion = 0.0, rate = 0.0;
+    double motion = 0.0, insideRise = 0.0, rate = 0.0;
     bool anySurface = false;
     for (size_t si = 0; si < L.phi.size(); ++si) {
       const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
       ls = levelSetStep(L.phi[si], phi0, *L.ghat, mask, chunkSettings, *L.scratch, &L.bands[si]);
       const double n = double(std::max(ls.substeps, 1));
       motion = std::max(motion, ls.nearMaxChange * n);
-      farMotion = std::max(farMotion, ls.insideRise * n);
+      insideRise = std::max(insideRise, ls.insideRise * n);
       rate = std::max(rate, ls.nearMaxChange);
       anySurface = anySurface || ls.hasInterface;
     }
     L.motionSinceRedistance += motion;
-    L.farMotionSinceRedistance += farMotion;
+    L.insideRiseSinceRedistance += insideRise;
     L.lastMotion += motion;
     st.sdfStepMs += msSince(ts);
     auto t1 = Clock::now();
@@ -631,7 +631,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     // substep while redistancing pushes them out again, which ran redistancing every ten
     // substeps without any surface moving.)
     if (L.motionSinceRedistance >= 0.5 * h ||
-        L.farMotionSinceRedistance >= double(kNearSurfaceBand) * h) {
+        L.insideRiseSinceRedistance >= double(kNearSurfaceBand) * h) {
       for (size_t si = 0; si < L.phi.size(); ++si) {
         const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
         RedistanceStats rs = redistance(L.phi[si], in.levelSet, *L.scratch, &phi0,
@@ -642,7 +642,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
         st.redistanceResidual = std::max(st.redistanceResidual, rs.meanSquaredChange);
       }
       L.motionSinceRedistance = 0.0;
-      L.farMotionSinceRedistance = 0.0;
+      L.insideRiseSinceRedistance = 0.0;
     }
     st.redistanceMs += msSince(t1);
     // Every surface has vanished (ghat >= lambda all over it): there is nothing left to move,

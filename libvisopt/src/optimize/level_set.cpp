@@ -321,11 +321,7 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   const bool banded = useBand(s) && s.substeps > 0;
   if (banded) {
     // Without the return term (lambda = 0) phi0 and the region the surface swept need no band.
-    // A new band also takes the bricks its faces claim (NarrowBand::refresh).
-    if (!narrow.builtFor(phi, s.band)) {
-      narrow.build(phi, s.lambda > 0.f ? &phi0 : nullptr, s.band);
-      narrow.refresh(phi);
-    }
+    narrow.ensure(phi, s.lambda > 0.f ? &phi0 : nullptr, s.band);
     stats.bandVoxels = narrow.band().voxels;
     copySpans(phi, scratch, narrow.halo());
     stats.timeStep = timeStepFrom(stepBoundsWithin(ghat, narrow.band()), ghat.grid(), s);
@@ -379,10 +375,7 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
   NarrowBand& narrow = band ? *band : own;
   const bool banded = useBand(s) && s.redistanceIterations > 0;
   // A band built by the step serves as it is (with phi0 when the return term is on).
-  if (banded && !narrow.builtFor(phi, s.band)) {
-    narrow.build(phi, base, s.band);
-    narrow.refresh(phi);
-  }
+  if (banded) narrow.ensure(phi, base, s.band);
   const bool surface = banded ? interfaceWithin(phi, narrow.halo()) : hasInterface(phi);
   if (!surface) {
     stats.converged = true;

@@ -131,6 +131,12 @@ bool NarrowBand::builtFor(const Field3D& phi, float halfWidthVoxels) const {
          halfWidthVoxels == halfWidthVoxels_;
 }
 
+void NarrowBand::ensure(Field3D& phi, const Field3D* phi0, float halfWidthVoxels) {
+  if (builtFor(phi, halfWidthVoxels)) return;
+  build(phi, phi0, halfWidthVoxels);
+  refresh(phi);
+}
+
 void NarrowBand::refresh(Field3D& phi) {
   lastActivated_ = lastReleased_ = 0;
   if (flags_.empty()) return;

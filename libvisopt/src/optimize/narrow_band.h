@@ -53,6 +53,9 @@ class NarrowBand {
   void build(const Field3D& phi, const Field3D* phi0, float halfWidthVoxels);
   // True when built for phi (its storage and grid) and this half-width, from any base.
   bool builtFor(const Field3D& phi, float halfWidthVoxels) const;
+  // The band for phi (built from phi and phi0 unless builtFor(phi, halfWidthVoxels) already,
+  // then refreshed once so that it also holds the bricks its faces claim).
+  void ensure(Field3D& phi, const Field3D* phi0, float halfWidthVoxels);
   // After phi changed inside the active bricks only: their distances again (reading those bricks
   // only), neighbours activated across faces near the surface, bricks far from it released.
   void refresh(Field3D& phi);

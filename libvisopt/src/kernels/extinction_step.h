@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "core/field_view.h"
+#include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
 #include "kernels/optimizer_update.h"
@@ -37,7 +38,7 @@ struct BaseExtinction {
 };
 
 // Gathers a frustum field at a world position; 0 outside the frustum.
-VISOPT_HD inline float gatherFrustum(const FrustumMap& f, const FieldView& d, glm::vec3 x) {
+VISOPT_HD inline float gatherFrustum(const FrustumMap& f, const FrustumFieldView& d, glm::vec3 x) {
   if (!d.valid()) return 0.f;
   const glm::vec3 y = f.toGrid(x);
   if (!d.inside(y)) return 0.f;
@@ -50,7 +51,7 @@ struct ExtinctionGradient {
   BaseExtinction base;
   float rho = 1.f, q = 1.f, r = 0.f;
   FrustumMap view, light;
-  FieldView dView, dLight;  // dLight invalid when r == 0
+  FrustumFieldView dView, dLight;  // dLight invalid when r == 0
 
   VISOPT_HD VISOPT_INLINE float at(int64_t v, float& mbar) const {
     const int nx = volume.dims.x, ny = volume.dims.y;

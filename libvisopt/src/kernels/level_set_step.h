@@ -27,17 +27,9 @@
 #include "core/field_view.h"
 #include "core/half.h"
 #include "core/hd.h"
+#include "core/min_max.h"
 
 namespace visopt {
-
-// fmaxf / fminf without their NaN rules: one instruction each on the CPU (g++ calls libm for
-// fmaxf unless math is relaxed), so the row loops stay branch-free.
-VISOPT_HD VISOPT_INLINE float maxOf(float a, float b) {
-  return a > b ? a : b;
-}
-VISOPT_HD VISOPT_INLINE float minOf(float a, float b) {
-  return a < b ? a : b;
-}
 
 // ---- storage accessors ------------------------------------------------------------------------
 

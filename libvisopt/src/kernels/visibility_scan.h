@@ -27,6 +27,7 @@
 #include <cstdint>
 
 #include "core/field_view.h"
+#include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
 #include "kernels/screen_weights.h"
@@ -62,12 +63,12 @@ struct ScanSums {
 struct VisibilityScan {
   FrustumMap frustum;
   GridMap volume;
-  FieldView mu;           // extinction on the object grid
-  FieldView importance;   // g on the object grid
-  FieldView out;          // d on the frustum grid; T is kept there between the two passes
-  SurfaceSet surfaces;    // opaque context surfaces on the object grid (may be empty)
-  ScreenWeights weights;  // view rays only
-  FieldView behindMax;    // optional: max of g behind each cell, on the frustum grid
+  FieldView mu;                // extinction on the object grid
+  FieldView importance;        // g on the object grid
+  FrustumFieldView out;        // d on the frustum grid; T is kept there between the two passes
+  SurfaceSet surfaces;         // opaque context surfaces on the object grid (may be empty)
+  ScreenWeights weights;       // view rays only
+  FrustumFieldView behindMax;  // optional: max of g behind each cell, on the frustum grid
 
   // Pixel solid angle (for cell volumes): the tan-plane area over (1 + u^2 + v^2)^(3/2).
   VISOPT_HD float solidAngle(int i, int j) const {

@@ -9,7 +9,7 @@
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "kernels/extinction_step.h"
-#include "kernels/visibility_scan.h"
+#include "kernels/visibility_scan_fast.h"
 #include "optimize/level_set.h"
 #include "optimize/narrow_band.h"
 #include "visopt/error.h"
@@ -39,10 +39,11 @@ ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& 
                   const SurfaceSet& surfaces = {}, const ScreenWeights& weights = {},
                   std::optional<Field3D>* behindMax = nullptr, const char* maxName = nullptr) {
   auto ensure = [&](std::optional<Field3D>& f, const char* fname) {
-    if (!f || f->grid().dims != frustum.dims) {
+    const glm::ivec3 storage = frustumStorageDims(frustum.dims);
+    if (!f || f->grid().dims != storage) {
       f.reset();
       GridSpec fg;
-      fg.dims = frustum.dims;
+      fg.dims = storage;
       f.emplace(fname, fg, precision, ledger);
     }
   };
@@ -52,15 +53,18 @@ ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& 
   scan.volume = GridMap(grid);
   scan.mu = FieldView(mu);
   scan.importance = FieldView(importance);
-  scan.out = FieldView(*d);
+  scan.out = FrustumFieldView(*d, frustum.dims);
   scan.surfaces = surfaces;
   scan.weights = weights;
   if (behindMax) {
     ensure(*behindMax, maxName);
-    scan.behindMax = FieldView(**behindMax);
+    scan.behindMax = FrustumFieldView(**behindMax, frustum.dims);
   }
-  return exec::reduce(name, int64_t(frustum.dims.x) * frustum.dims.y, ScanSums{}, scan,
-                      [] VISOPT_HD(const ScanSums& a, const ScanSums& b) { return a + b; });
+  const int64_t rays = int64_t(frustum.dims.x) * frustum.dims.y;
+  auto sum = [] VISOPT_HD(const ScanSums& a, const ScanSums& b) { return a + b; };
+  if (frustum.dims.z <= kScanBufferCells)
+    return exec::reduce(name, rays, ScanSums{}, FastVisibilityScan<kScanBufferCells>{scan}, sum);
+  return exec::reduce(name, rays, ScanSums{}, FastVisibilityScan<0>{scan}, sum);
 }
 
 ExtinctionGradient gradientOf(const ExtinctionProblem& p, const Field3D* dView,
@@ -76,8 +80,8 @@ ExtinctionGradient gradientOf(const ExtinctionProblem& p, const Field3D* dView,
   g.r = dLight ? p.r : 0.f;
   g.view = FrustumMap(p.view);
   g.light = FrustumMap(p.light);
-  if (dView) g.dView = FieldView(*dView);
-  if (dLight) g.dLight = FieldView(*dLight);
+  if (dView) g.dView = FrustumFieldView(*dView, p.view.dims);
+  if (dLight) g.dLight = FrustumFieldView(*dLight, p.light.dims);
   return g;
 }
 
@@ -563,8 +567,10 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   const GridMap map(L.grid);
   FieldView ghat(*L.ghat);
   const FrustumMap view(L.view), light(L.light);
-  const FieldView viewMax = L.viewMax ? FieldView(*L.viewMax) : FieldView();
-  const FieldView lightMax = L.lightMax ? FieldView(*L.lightMax) : FieldView();
+  const FrustumFieldView viewMax =
+      L.viewMax ? FrustumFieldView(*L.viewMax, L.view.dims) : FrustumFieldView();
+  const FrustumFieldView lightMax =
+      L.lightMax ? FrustumFieldView(*L.lightMax, L.light.dims) : FrustumFieldView();
   // The lens and windowing masks weigh the light half too, by the screen position of x: under
   // a lens of strength 0 a surface keeps its shape, not opening towards the light either.
   const ScreenWeights weights = screenWeightsOf(in);

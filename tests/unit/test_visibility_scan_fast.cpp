@@ -1,0 +1,202 @@
+// The fast visibility scan (kernels/visibility_scan_fast.h, what the optimiser runs) against the
+// reference per-ray scan (kernels/visibility_scan.h): the same d, the same running maximum of g
+// behind each cell (half of ghat, Eq. 19) and the same sums (energies, V, V_occ) to float
+// round-off, on small grids with and without context surfaces, a lens, a screen mask, view and
+// light frusta, fp32 and fp16, with the per-ray buffer and without it (the form CUDA compiles).
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/frustum_field.h"
+#include "core/frustum_map.h"
+#include "exec/parallel.h"
+#include "kernels/visibility_scan_fast.h"
+#include "visopt/camera.h"
+#include "visopt/field.h"
+#include "visopt/frustum.h"
+
+using namespace visopt;
+
+namespace {
+
+enum class Weights { None, Lens, Mask };
+
+struct Case {
+  Precision precision;
+  int surfaces;  // 0, 1 or 2 spheres
+  Weights weights;
+  bool lightFrustum;
+  bool behindMax;
+  std::string name() const {
+    return std::string(precision == Precision::FP16 ? "fp16" : "fp32") + "_surfaces" +
+           std::to_string(surfaces) +
+           (weights == Weights::Lens   ? "_lens"
+            : weights == Weights::Mask ? "_mask"
+                                       : "") +
+           (lightFrustum ? "_light" : "_view") + (behindMax ? "_max" : "");
+  }
+};
+
+struct Scene {
+  GridSpec grid;
+  Field3D mu, g, mask;
+  Field3D phi[2];
+  FrustumGrid frustum;
+};
+
+// mu: random, zero in a slab (empty space keeps T); g: random in a ball, zero elsewhere.
+Scene makeScene(const Case& c) {
+  Scene s;
+  s.grid.dims = glm::ivec3(23, 19, 17);
+  s.grid.spacing = glm::vec3(0.05f, 0.06f, 0.055f);
+  s.grid.origin = -0.5f * glm::vec3(s.grid.dims - 1) * s.grid.spacing;
+  s.mu = Field3D("mu", s.grid, c.precision);
+  s.g = Field3D("g", s.grid, c.precision);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.f, 1.f);
+  const glm::ivec3 n = s.grid.dims;
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        const size_t v = (size_t(k) * n.y + j) * n.x + i;
+        const glm::vec3 x = s.grid.origin + glm::vec3(i, j, k) * s.grid.spacing;
+        s.mu.set(v, i > 15 && i < 19 ? 0.f : 6.f * u(rng));
+        s.g.set(v, glm::length(x - glm::vec3(0.1f, 0.f, 0.05f)) < 0.3f ? u(rng) : 0.f);
+      }
+  const glm::vec3 centres[2] = {{-0.2f, 0.05f, 0.f}, {0.15f, -0.1f, 0.1f}};
+  for (int sIdx = 0; sIdx < c.surfaces; ++sIdx) {
+    s.phi[sIdx] = Field3D("phi", s.grid, c.precision);
+    for (int k = 0; k < n.z; ++k)
+      for (int j = 0; j < n.y; ++j)
+        for (int i = 0; i < n.x; ++i) {
+          const glm::vec3 x = s.grid.origin + glm::vec3(i, j, k) * s.grid.spacing;
+          s.phi[sIdx].set((size_t(k) * n.y + j) * n.x + i, glm::length(x - centres[sIdx]) - 0.18f);
+        }
+  }
+  const Bounds bounds = s.grid.worldBounds();
+  if (c.lightFrustum) {
+    PointLight light;
+    light.position = glm::vec3(1.2f, -0.9f, 1.5f);
+    s.frustum = FrustumGrid::forLight(light, bounds, glm::ivec3(21, 21, 0), s.grid.minSpacing());
+  } else {
+    Camera cam;
+    cam.eye = glm::vec3(0.4f, -2.1f, 0.7f);
+    cam.target = glm::vec3(0.02f, 0.01f, -0.03f);
+    s.frustum = FrustumGrid::forCamera(cam, 26, 20, bounds, 0, s.grid.minSpacing());
+  }
+  if (c.weights == Weights::Mask) {
+    GridSpec mg;
+    mg.dims = glm::ivec3(9, 7, 1);
+    s.mask = Field3D("screen mask", mg, Precision::FP32);
+    for (size_t v = 0; v < s.mask.size(); ++v) s.mask.set(v, u(rng));
+  }
+  return s;
+}
+
+struct Result {
+  std::vector<float> d, behindMax;
+  ScanSums sums;
+};
+
+template <class Kernel>
+Result run(const Scene& s, const Case& c) {
+  GridSpec fg;
+  fg.dims = frustumStorageDims(s.frustum.dims);
+  Field3D out("d", fg, c.precision), behind("behind max", fg, c.precision);
+  Kernel kernel{};
+  VisibilityScan& scan = [&]() -> VisibilityScan& {
+    if constexpr (std::is_same_v<Kernel, VisibilityScan>)
+      return kernel;
+    else
+      return kernel.scan;
+  }();
+  scan.frustum = FrustumMap(s.frustum);
+  scan.volume = GridMap(s.grid);
+  scan.mu = FieldView(s.mu);
+  scan.importance = FieldView(s.g);
+  scan.out = FrustumFieldView(out, s.frustum.dims);
+  scan.surfaces.count = c.surfaces;
+  for (int i = 0; i < c.surfaces; ++i) scan.surfaces.phi[i] = FieldView(s.phi[i]);
+  if (c.weights == Weights::Lens) {
+    scan.weights.lensCentre = glm::vec2(0.45f, 0.55f);
+    scan.weights.lensRadius = 0.3f;
+    scan.weights.lensStrength = 0.2f;
+  } else if (c.weights == Weights::Mask) {
+    scan.weights.mask = FieldView(s.mask);
+  }
+  if (c.behindMax) scan.behindMax = FrustumFieldView(behind, s.frustum.dims);
+  Result r;
+  r.sums = exec::reduce("test scan", int64_t(s.frustum.dims.x) * s.frustum.dims.y, ScanSums{},
+                        kernel, [](const ScanSums& a, const ScanSums& b) { return a + b; });
+  const glm::ivec3 n = s.frustum.dims;
+  for (int k = 0; k < n.z; ++k)
+    for (int j = 0; j < n.y; ++j)
+      for (int i = 0; i < n.x; ++i) {
+        r.d.push_back(scan.out.at(i, j, k));
+        if (c.behindMax) r.behindMax.push_back(scan.behindMax.at(i, j, k));
+      }
+  return r;
+}
+
+void expectSame(const Result& ref, const Result& fast, const Case& c, const char* form) {
+  SCOPED_TRACE(c.name() + " " + form);
+  // fp16 stores d with 11 significant bits; fp32 differs only by the order of float operations.
+  const float rel = c.precision == Precision::FP16 ? 2e-3f : 2e-5f;
+  ASSERT_EQ(ref.d.size(), fast.d.size());
+  float scale = 0.f;
+  for (float v : ref.d) scale = std::max(scale, std::abs(v));
+  ASSERT_GT(scale, 0.f);
+  size_t nonzero = 0;
+  for (size_t i = 0; i < ref.d.size(); ++i) {
+    ASSERT_NEAR(ref.d[i], fast.d[i], rel * scale) << "cell " << i;
+    nonzero += ref.d[i] != 0.f;
+  }
+  EXPECT_GT(nonzero, ref.d.size() / 20);  // the rays do cross the volume
+  ASSERT_EQ(ref.behindMax.size(), fast.behindMax.size());
+  for (size_t i = 0; i < ref.behindMax.size(); ++i)
+    ASSERT_NEAR(ref.behindMax[i], fast.behindMax[i], rel) << "cell " << i;
+  auto near = [&](double a, double b, const char* what) {
+    EXPECT_NEAR(a, b, 1e-5 * std::max(std::abs(a), 1e-12)) << what;
+  };
+  EXPECT_GT(ref.sums.gMu, 0.0);
+  near(ref.sums.gMuT, fast.sums.gMuT, "sum g mu T dV");
+  near(ref.sums.gMu, fast.sums.gMu, "sum g mu dV");
+  near(ref.sums.importantSeen, fast.sums.importantSeen, "V_occ numerator");
+  near(ref.sums.importantSeenAlone, fast.sums.importantSeenAlone, "V_occ denominator");
+}
+
+}  // namespace
+
+TEST(FastVisibilityScan, MatchesTheReferenceScan) {
+  int cases = 0;
+  for (Precision p : {Precision::FP32, Precision::FP16})
+    for (int surfaces : {0, 1, 2})
+      for (Weights w : {Weights::None, Weights::Lens, Weights::Mask})
+        for (bool light : {false, true}) {
+          const Case c{p, surfaces, w, light, surfaces > 0 || w == Weights::Lens};
+          const Scene s = makeScene(c);
+          const Result ref = run<VisibilityScan>(s, c);
+          expectSame(ref, run<FastVisibilityScan<kScanBufferCells>>(s, c), c, "buffered");
+          expectSame(ref, run<FastVisibilityScan<0>>(s, c), c, "unbuffered");
+          ++cases;
+        }
+  EXPECT_EQ(cases, 36);
+}
+
+// A surface in front of everything blocks every ray from its first cell: d and T vanish behind
+// it in both kernels, and the fast kernel still reports the whole volume in sum g mu dV.
+TEST(FastVisibilityScan, ASurfaceAroundTheVolumeHidesAll) {
+  Case c{Precision::FP32, 1, Weights::None, false, true};
+  Scene s = makeScene(c);
+  for (size_t v = 0; v < s.phi[0].size(); ++v) s.phi[0].set(v, -1.f);
+  const Result ref = run<VisibilityScan>(s, c);
+  const Result fast = run<FastVisibilityScan<kScanBufferCells>>(s, c);
+  EXPECT_EQ(fast.sums.gMuT, 0.0);
+  EXPECT_EQ(fast.sums.importantSeen, 0.0);
+  EXPECT_GT(fast.sums.gMu, 0.0);
+  EXPECT_NEAR(fast.sums.gMu, ref.sums.gMu, 1e-5 * ref.sums.gMu);
+  for (size_t i = 0; i < fast.d.size(); ++i) ASSERT_EQ(fast.d[i], 0.f);
+}

@@ -15,7 +15,9 @@
 #include <glm/glm.hpp>
 
 #include "core/field_view.h"
+#include "core/half.h"
 #include "core/hd.h"
+#include "core/min_max.h"
 #include "visopt/field.h"
 
 namespace visopt {
@@ -48,20 +50,34 @@ struct FrustumFieldView {
   VISOPT_HD VISOPT_INLINE float at(int i, int j, int k) const { return load(index(i, j, k)); }
 
   // Trilinear interpolation at continuous frustum coordinates (cell centres at integers),
-  // clamped to the grid as FieldView::sample clamps.
+  // clamped to the grid as FieldView::sample clamps, in its order of operations. The eight
+  // corners lie in four columns (i, j) of a tile, two depths each.
   VISOPT_HD VISOPT_INLINE float sample(glm::vec3 p) const {
-    p = glm::clamp(p, glm::vec3(0.f), glm::vec3(dims - 1));
-    const glm::ivec3 i0 = glm::ivec3(p);
-    const glm::ivec3 i1 = glm::min(i0 + 1, dims - 1);
-    const glm::vec3 f = p - glm::vec3(i0);
-    const float c000 = at(i0.x, i0.y, i0.z), c100 = at(i1.x, i0.y, i0.z);
-    const float c010 = at(i0.x, i1.y, i0.z), c110 = at(i1.x, i1.y, i0.z);
-    const float c001 = at(i0.x, i0.y, i1.z), c101 = at(i1.x, i0.y, i1.z);
-    const float c011 = at(i0.x, i1.y, i1.z), c111 = at(i1.x, i1.y, i1.z);
-    const float c00 = c000 + f.x * (c100 - c000), c10 = c010 + f.x * (c110 - c010);
-    const float c01 = c001 + f.x * (c101 - c001), c11 = c011 + f.x * (c111 - c011);
-    const float c0 = c00 + f.y * (c10 - c00), c1 = c01 + f.y * (c11 - c01);
-    return c0 + f.z * (c1 - c0);
+    const float px = minOf(maxOf(p.x, 0.f), float(dims.x - 1));
+    const float py = minOf(maxOf(p.y, 0.f), float(dims.y - 1));
+    const float pz = minOf(maxOf(p.z, 0.f), float(dims.z - 1));
+    const int i0 = int(px), j0 = int(py), k0 = int(pz);
+    const int i1 = i0 + 1 < dims.x ? i0 + 1 : i0, j1 = j0 + 1 < dims.y ? j0 + 1 : j0;
+    const size_t dk = k0 + 1 < dims.z ? kTileRays : 0;
+    const float fx = px - float(i0), fy = py - float(j0), fz = pz - float(k0);
+    const size_t c00 = index(i0, j0, k0), c10 = index(i1, j0, k0);
+    const size_t c01 = index(i0, j1, k0), c11 = index(i1, j1, k0);
+    float v[8];
+    if (storage.half) {
+      const Half* h = static_cast<const Half*>(storage.data);
+      v[0] = halfToFloat(h[c00]), v[1] = halfToFloat(h[c10]);
+      v[2] = halfToFloat(h[c01]), v[3] = halfToFloat(h[c11]);
+      v[4] = halfToFloat(h[c00 + dk]), v[5] = halfToFloat(h[c10 + dk]);
+      v[6] = halfToFloat(h[c01 + dk]), v[7] = halfToFloat(h[c11 + dk]);
+    } else {
+      const float* f = static_cast<const float*>(storage.data);
+      v[0] = f[c00], v[1] = f[c10], v[2] = f[c01], v[3] = f[c11];
+      v[4] = f[c00 + dk], v[5] = f[c10 + dk], v[6] = f[c01 + dk], v[7] = f[c11 + dk];
+    }
+    const float a00 = v[0] + fx * (v[1] - v[0]), a10 = v[2] + fx * (v[3] - v[2]);
+    const float a01 = v[4] + fx * (v[5] - v[4]), a11 = v[6] + fx * (v[7] - v[6]);
+    const float a0 = a00 + fy * (a10 - a00), a1 = a01 + fy * (a11 - a01);
+    return a0 + fz * (a1 - a0);
   }
   // True when p lies within the cell-centred grid's support [-0.5, dims - 0.5].
   VISOPT_HD bool inside(glm::vec3 p) const {

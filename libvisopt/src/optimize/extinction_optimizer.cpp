@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 
+#include "core/brick_order.h"
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
@@ -574,24 +575,25 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   // The lens and windowing masks weigh the light half too, by the screen position of x: under
   // a lens of strength 0 a surface keeps its shape, not opening towards the light either.
   const ScreenWeights weights = screenWeightsOf(in);
-  exec::parallelFor(
-      "grid updates: importance behind", int64_t(L.grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
-        const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-                  k = int(v / (int64_t(map.dims.x) * map.dims.y));
-        const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
-        const float vm = gatherFrustum(view, viewMax, x);
-        float g = vm;
-        if (lightMax.valid()) {
-          float lm = gatherFrustum(light, lightMax, x);
-          if (weights.active()) {
-            const glm::vec3 y = view.toGrid(x);
-            if (y.z >= -0.5f && y.z <= float(view.dims.z) - 0.5f)
-              lm = fminf(lm * weights.atPoint(y.x, y.y, view.dims.x, view.dims.y), 1.f);
-          }
-          g = 0.5f * vm + 0.5f * lm;
-        }
-        ghat.store(size_t(v), fminf(fmaxf(g, 0.f), 1.f));
-      });
+  const BrickOrder order(map.dims);
+  exec::parallelFor("grid updates: importance behind", order.launches(), [=] VISOPT_HD(int64_t n) {
+    int i, j, k;
+    if (!order.voxel(n, i, j, k)) return;
+    const size_t v = (size_t(k) * size_t(map.dims.y) + size_t(j)) * size_t(map.dims.x) + size_t(i);
+    const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
+    const float vm = gatherFrustum(view, viewMax, x);
+    float g = vm;
+    if (lightMax.valid()) {
+      float lm = gatherFrustum(light, lightMax, x);
+      if (weights.active()) {
+        const glm::vec3 y = view.toGrid(x);
+        if (y.z >= -0.5f && y.z <= float(view.dims.z) - 0.5f)
+          lm = fminf(lm * weights.atPoint(y.x, y.y, view.dims.x, view.dims.y), 1.f);
+      }
+      g = 0.5f * vm + 0.5f * lm;
+    }
+    ghat.store(v, fminf(fmaxf(g, 0.f), 1.f));
+  });
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   st.sdfStepMs = msSince(t0);
   // The level-set substeps run in chunks; redistancing (Eq. 18) runs once the steps since the

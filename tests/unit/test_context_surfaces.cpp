@@ -10,6 +10,8 @@
 // 1.5 thick), as in the paper's figures where the important structures are large.
 #include <cmath>
 
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "occluder_scene.h"
@@ -153,4 +155,47 @@ TEST(ContextSurfaces, LensAndScreenMaskModulateTheImportanceAlongTheirRays) {
     e.setScreenMask(w, 32, 32);
   });
   EXPECT_LT(masked.first, 0.05) << "a zero window over the disc keeps it hidden";
+}
+
+// ghat (Eq. 19) depends on the importance, the frusta and the screen weights only, so a run
+// computes it once per level (ExtinctionOptimizer::Level::ghatFixed). The premise, checked on
+// the path that recomputes it every iteration: after 30 more iterations that opened the surface
+// and changed mu, ghat is bit for bit what a whole run kept from its first iteration.
+TEST(ContextSurfaces, TheImportanceBehindDoesNotChangeAsTheSurfaceOpens) {
+  Engine kept;
+  setup(kept);
+  ExtinctionSettings s = kept.extinctionSettings();
+  s.maxIterationsPerLevel = s.minIterationsPerLevel = 20;
+  kept.setExtinctionSettings(s);
+  kept.optimize();
+  Engine recomputed;
+  setup(recomputed);
+  s.maxIterationsPerLevel = s.minIterationsPerLevel = 1;
+  recomputed.setExtinctionSettings(s);
+  recomputed.optimize();
+  const Field3D* phi = recomputed.contextSurfacePhi(0);
+  std::vector<float> phiBefore(phi->size());
+  for (size_t v = 0; v < phi->size(); ++v) phiBefore[v] = phi->get(v);
+  recomputed.continueOptimization(19);
+  size_t moved = 0;
+  const float h = recomputed.volume().grid().minSpacing();
+  for (size_t v = 0; v < phi->size(); ++v)
+    moved += std::abs(phi->get(v) - phiBefore[v]) > 0.1f * h && std::abs(phi->get(v)) < 2.f * h;
+  EXPECT_GT(moved, 50u) << "the surface moved meanwhile";
+  const Field3D* a = kept.importanceBehind();
+  const Field3D* b = recomputed.importanceBehind();
+  ASSERT_TRUE(a && b);
+  ASSERT_EQ(a->size(), b->size());
+  double sum = 0.0;
+  for (size_t v = 0; v < a->size(); ++v) {
+    ASSERT_EQ(a->get(v), b->get(v)) << "voxel " << v;
+    sum += a->get(v);
+  }
+  EXPECT_GT(sum, 0.0);
+  // A new camera gives a new ghat at once on the continuing path (the workstation's).
+  kept.setCamera(Camera::orbit({0, 0, 0}, 90.f, 0.f, 90.f));
+  kept.continueOptimization(1);
+  size_t changed = 0;
+  for (size_t v = 0; v < b->size(); ++v) changed += kept.importanceBehind()->get(v) != b->get(v);
+  EXPECT_GT(changed, b->size() / 100);
 }

@@ -48,6 +48,7 @@ nlohmann::json statsJson(const IterationStats& s) {
           {"level_set_time_step", s.levelSetTimeStep},
           {"level_set_substeps", s.levelSetSubsteps},
           {"level_set_motion_voxels", s.levelSetMotionVoxels},
+          {"level_set_crossed_voxels", s.levelSetCrossedVoxels},
           {"max_deviation_voxels", s.maxDeviationVoxels},
           {"mean_deviation_voxels", s.meanDeviationVoxels}};
 }

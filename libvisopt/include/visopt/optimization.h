@@ -72,7 +72,10 @@ struct IterationStats {
   double levelSetTimeStep = 0.0;
   int levelSetSubsteps = 0;           // substeps of Eq. 23 this iteration
   double levelSetMotionVoxels = 0.0;  // bound on how far phi moved this iteration, voxels
-  double maxDeviationVoxels = 0.0;    // |phi0| on the current surface, over surface voxels
+  // Voxels whose side of a surface changed between the iteration's start and end: the net
+  // motion, where levelSetMotionVoxels also counts churn that returns to where it started.
+  int64_t levelSetCrossedVoxels = 0;
+  double maxDeviationVoxels = 0.0;  // |phi0| on the current surface, over surface voxels
   double meanDeviationVoxels = 0.0;
 };
 

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "core/brick_order.h"
+#include "core/device_buffer.h"
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
@@ -163,6 +164,13 @@ struct ExtinctionOptimizer::Level {
   double lastMotion = 0.0;  // bound on how far the surfaces moved in the last iteration, world
                             // units
   double lastEnergy = 0.0;
+  // Set by runMultigrid after the level's first iteration: ghat (Eq. 19) depends on the
+  // importance, the view and light frusta and the screen weights only, none of which changes
+  // within a run, so the frustum maxima of g and the importance-behind gather are not redone.
+  bool ghatFixed = false;
+  // The side of every surface each voxel lay on when this iteration's level-set steps began
+  // (bit set: inside, phi < 0), 64 voxels per word.
+  std::vector<DeviceBuffer<uint64_t>> insideAtStart;
 };
 
 ExtinctionOptimizer::ExtinctionOptimizer(MemoryLedger* ledger, Precision precision)
@@ -463,6 +471,11 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   IterationStats st;
   st.level = L.index;
   const bool hasSurfaces = !L.phi.empty();
+  const bool ghatNeeded = hasSurfaces && !L.ghatFixed;
+  if (L.ghatFixed) {  // model only what the scene needs: the maxima are in ghat now
+    L.viewMax.reset();
+    L.lightMax.reset();
+  }
   SurfaceSet surfaces;
   for (size_t si = 0; si < L.phi.size() && si < size_t(kMaxContextSurfaces); ++si)
     surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
@@ -472,13 +485,13 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   if (p.q != 0.f || hasSurfaces)
     view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, L.dView,
                     "view-derivative", precision_, ledger_, surfaces, weights,
-                    hasSurfaces ? &L.viewMax : nullptr, "view-importance-behind");
+                    ghatNeeded ? &L.viewMax : nullptr, "view-importance-behind");
   else
     L.dView.reset();
   if (lightGrids)
     light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
                      "light-derivative", precision_, ledger_, surfaces, ScreenWeights{},
-                     hasSurfaces ? &L.lightMax : nullptr, "light-importance-behind");
+                     ghatNeeded ? &L.lightMax : nullptr, "light-importance-behind");
   else
     L.lightMax.reset();
   st.gridUpdatesMs = msSince(t0);
@@ -561,6 +574,42 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   return st;
 }
 
+namespace {
+
+// One bit per voxel: phi < 0.
+void recordInside(const Field3D& phi, DeviceBuffer<uint64_t>& bits) {
+  const size_t n = phi.size(), words = (n + 63) / 64;
+  if (bits.size() != words) bits = DeviceBuffer<uint64_t>(words);
+  const FieldView f(phi);
+  uint64_t* out = bits.data();
+  exec::parallelFor("level set: record sides", int64_t(words), [=] VISOPT_HD(int64_t w) {
+    uint64_t word = 0;
+    const size_t first = size_t(w) * 64;
+    for (size_t b = 0; b < 64 && first + b < n; ++b)
+      if (f.load(first + b) < 0.f) word |= uint64_t(1) << b;
+    out[w] = word;
+  });
+}
+
+// Voxels whose side of the surface differs from the recorded one.
+int64_t crossedSince(const Field3D& phi, const DeviceBuffer<uint64_t>& bits) {
+  const size_t n = phi.size();
+  const FieldView f(phi);
+  const uint64_t* in = bits.data();
+  return exec::reduce(
+      "level set: crossed voxels", int64_t(bits.size()), int64_t(0),
+      [=] VISOPT_HD(int64_t w) {
+        int64_t crossed = 0;
+        const size_t first = size_t(w) * 64;
+        for (size_t b = 0; b < 64 && first + b < n; ++b)
+          crossed += ((in[w] >> b) & 1) != (f.load(first + b) < 0.f ? 1u : 0u);
+        return crossed;
+      },
+      [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+}
+
+}  // namespace
+
 void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, IterationStats& st) {
   // ghat (Eq. 19): half the max importance behind x along the view ray, half along the light
   // ray (the light grids exist whenever there are surfaces).
@@ -576,24 +625,27 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   // a lens of strength 0 a surface keeps its shape, not opening towards the light either.
   const ScreenWeights weights = screenWeightsOf(in);
   const BrickOrder order(map.dims);
-  exec::parallelFor("grid updates: importance behind", order.launches(), [=] VISOPT_HD(int64_t n) {
-    int i, j, k;
-    if (!order.voxel(n, i, j, k)) return;
-    const size_t v = (size_t(k) * size_t(map.dims.y) + size_t(j)) * size_t(map.dims.x) + size_t(i);
-    const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
-    const float vm = gatherFrustum(view, viewMax, x);
-    float g = vm;
-    if (lightMax.valid()) {
-      float lm = gatherFrustum(light, lightMax, x);
-      if (weights.active()) {
-        const glm::vec3 y = view.toGrid(x);
-        if (y.z >= -0.5f && y.z <= float(view.dims.z) - 0.5f)
-          lm = fminf(lm * weights.atPoint(y.x, y.y, view.dims.x, view.dims.y), 1.f);
-      }
-      g = 0.5f * vm + 0.5f * lm;
-    }
-    ghat.store(v, fminf(fmaxf(g, 0.f), 1.f));
-  });
+  if (!L.ghatFixed)
+    exec::parallelFor(
+        "grid updates: importance behind", order.launches(), [=] VISOPT_HD(int64_t n) {
+          int i, j, k;
+          if (!order.voxel(n, i, j, k)) return;
+          const size_t v =
+              (size_t(k) * size_t(map.dims.y) + size_t(j)) * size_t(map.dims.x) + size_t(i);
+          const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
+          const float vm = gatherFrustum(view, viewMax, x);
+          float g = vm;
+          if (lightMax.valid()) {
+            float lm = gatherFrustum(light, lightMax, x);
+            if (weights.active()) {
+              const glm::vec3 y = view.toGrid(x);
+              if (y.z >= -0.5f && y.z <= float(view.dims.z) - 0.5f)
+                lm = fminf(lm * weights.atPoint(y.x, y.y, view.dims.x, view.dims.y), 1.f);
+            }
+            g = 0.5f * vm + 0.5f * lm;
+          }
+          ghat.store(v, fminf(fmaxf(g, 0.f), 1.f));
+        });
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   st.sdfStepMs = msSince(t0);
   // The level-set substeps run in chunks; redistancing (Eq. 18) runs once the steps since the
@@ -602,6 +654,8 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   // by a small O(h) amount of its own (the subcell estimate next to the interface); run after
   // every tiny step it would undo slow surface motion, which is what happened with a thin shell
   // whose medial kink lies a voxel from the surface.
+  L.insideAtStart.resize(L.phi.size());
+  for (size_t si = 0; si < L.phi.size(); ++si) recordInside(L.phi[si], L.insideAtStart[si]);
   const double h = double(L.grid.minSpacing());
   LevelSetSettings chunkSettings = in.levelSet;
   // A chunk is as many substeps as keep the surface's motion under half a voxel at the rate of
@@ -665,6 +719,8 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   st.levelSetTimeStep = ls.timeStep;
   st.levelSetSubsteps = std::max(L.substeps, 1);
   st.levelSetMotionVoxels = L.lastMotion / h;
+  for (size_t si = 0; si < L.phi.size(); ++si)
+    st.levelSetCrossedVoxels += crossedSince(L.phi[si], L.insideAtStart[si]);
 
   // Deviation of the current surfaces from their base, over voxels on the current surface.
   const float hf = float(h);
@@ -745,6 +801,7 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
           previous && std::abs(st.meanDeviationVoxels - previous->meanDeviationVoxels) < 0.002 &&
           std::abs(st.maxDeviationVoxels - previous->maxDeviationVoxels) < 0.1;
       const bool surfacesSettled = st.levelSetMotionVoxels < 0.1 || deviationSteady;
+      level_->ghatFixed = true;
       previous = st;
       if (it + 1 >= s.minIterationsPerLevel && rel < s.tolerance && surfacesSettled) break;
     }
@@ -761,6 +818,7 @@ std::vector<IterationStats> ExtinctionOptimizer::iterate(const OptimizationInput
     buildLevel(in, s, 0, 1);  // start at the finest grid from mu_bar
   std::vector<IterationStats> all;
   for (int it = 0; it < iterations; ++it) {
+    level_->ghatFixed = false;  // the camera, light or importance may have changed meanwhile
     IterationStats st = runIteration(in, s, 1, std::max(iterations, s.maxIterationsPerLevel));
     st.level = level_->index;
     all.push_back(st);

@@ -1,0 +1,206 @@
+// The grid updates (paper 000 Eqs. 10-13: the visibility scan of one frustum grid) kernel by
+// kernel: the reference per-ray scan (kernels/visibility_scan.h) and the fast scan the optimiser
+// runs (kernels/visibility_scan_fast.h) on the same fields in the same run, against a STREAM-like
+// probe run in the same process.
+//
+// One benchmark per (kernel, volume N^3, view frustum F^2 or the light grid, precision, context
+// surface or not). The scene is synthetic and the same for every case: mu a smooth blob
+// (extinction up to ~8 per unit length in a unit box), g = 1 in a ball of radius 0.2 (0 outside),
+// and, with a surface, a sphere of radius 0.3 around it (its SDF) that blocks the rays that reach
+// it, as a skin hides a skull. View: 30 degrees at distance 3, depth cells one per half voxel;
+// light: ExtinctionSettings' default 128^2 rays from a point light above the volume.
+//
+// Counters: ns_cell_core (wall ns x threads per frustum cell), GBs (minimum bytes / time) and
+// frac (that / the probe's triad): minimum bytes = read mu and g once (2 V b), write d once and,
+// with a surface, the running maximum of g behind each cell (F b each); b = 2 or 4.
+// Environment: VISOPT_BENCH_FULL=1 adds the 256^3 volume with the 512^2 frustum.
+#include <benchmark/benchmark.h>
+
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/frustum_field.h"
+#include "core/frustum_map.h"
+#include "exec/parallel.h"
+#include "kernels/visibility_scan_fast.h"
+#include "stream_probe.h"
+#include "visopt/camera.h"
+#include "visopt/exec.h"
+#include "visopt/field.h"
+#include "visopt/frustum.h"
+
+namespace {
+
+using visopt::Precision;
+
+enum class Kernel { Reference, Fast };
+
+struct Case {
+  Kernel kernel;
+  int volume;
+  int frustum;  // view rays per side; 0: the light grid
+  Precision precision;
+  bool surface;
+};
+
+std::string nameOf(const Case& c) {
+  return std::string("scan/") + (c.kernel == Kernel::Fast ? "fast" : "reference") +
+         "/vol:" + std::to_string(c.volume) +
+         (c.frustum > 0 ? "/view:" + std::to_string(c.frustum) : std::string("/light:128")) + "/" +
+         visopt::toString(c.precision) + (c.surface ? "/surface" : "/no-surface");
+}
+
+struct Fields {
+  visopt::GridSpec grid;
+  visopt::Field3D mu, g, phi;
+};
+
+// Cached per (volume, precision): building the fields is not what is measured.
+Fields& fieldsFor(int n, Precision p) {
+  static std::vector<std::unique_ptr<Fields>> cache;
+  static std::vector<std::pair<int, Precision>> keys;
+  for (size_t i = 0; i < keys.size(); ++i)
+    if (keys[i].first == n && keys[i].second == p) return *cache[i];
+  if (cache.size() >= 2) {  // keep at most two sets alive (256^3 fp32: 3 x 64 MiB)
+    cache.erase(cache.begin());
+    keys.erase(keys.begin());
+  }
+  auto f = std::make_unique<Fields>();
+  f->grid.dims = glm::ivec3(n);
+  f->grid.spacing = glm::vec3(1.f / float(n));
+  f->grid.origin = glm::vec3(-0.5f + 0.5f / float(n));
+  f->mu = visopt::Field3D("mu", f->grid, p);
+  f->g = visopt::Field3D("g", f->grid, p);
+  f->phi = visopt::Field3D("phi", f->grid, p);
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const size_t v = (size_t(k) * n + j) * n + i;
+        const glm::vec3 x = f->grid.origin + glm::vec3(i, j, k) * f->grid.spacing;
+        const float r = glm::length(x);
+        f->mu.set(v, 8.f * std::exp(-6.f * r * r) * (0.6f + 0.4f * std::cos(20.f * x.x)));
+        f->g.set(v, r < 0.2f ? 1.f : 0.f);
+        f->phi.set(v, r - 0.3f);
+      }
+  keys.emplace_back(n, p);
+  cache.push_back(std::move(f));
+  return *cache.back();
+}
+
+visopt::FrustumGrid frustumFor(const Case& c, const visopt::GridSpec& grid) {
+  const visopt::Bounds bounds = grid.worldBounds();
+  if (c.frustum == 0) {
+    visopt::PointLight light;
+    light.position = glm::vec3(-1.5f, -2.f, 2.5f);
+    return visopt::FrustumGrid::forLight(light, bounds, glm::ivec3(128, 128, 0),
+                                         grid.minSpacing());
+  }
+  visopt::Camera cam;
+  cam.eye = glm::vec3(0.8f, -2.8f, 0.6f);
+  return visopt::FrustumGrid::forCamera(cam, c.frustum, c.frustum, bounds, 0, grid.minSpacing());
+}
+
+visopt::bench::StreamResult& stream() {
+  static visopt::bench::StreamResult s;
+  return s;
+}
+
+template <class K>
+visopt::ScanSums scan(const K& kernel, int64_t rays) {
+  return visopt::exec::reduce("bench scan", rays, visopt::ScanSums{}, kernel,
+                              [](const visopt::ScanSums& a, const visopt::ScanSums& b) {
+                                return a + b;
+                              });
+}
+
+void runCase(benchmark::State& state, const Case& c) {
+  Fields& f = fieldsFor(c.volume, c.precision);
+  const visopt::FrustumGrid frustum = frustumFor(c, f.grid);
+  visopt::GridSpec fg;
+  fg.dims = visopt::frustumStorageDims(frustum.dims);
+  visopt::Field3D out("d", fg, c.precision);
+  std::optional<visopt::Field3D> behind;
+  visopt::VisibilityScan s;
+  s.frustum = visopt::FrustumMap(frustum);
+  s.volume = visopt::GridMap(f.grid);
+  s.mu = visopt::FieldView(f.mu);
+  s.importance = visopt::FieldView(f.g);
+  s.out = visopt::FrustumFieldView(out, frustum.dims);
+  if (c.surface) {
+    s.surfaces.count = 1;
+    s.surfaces.phi[0] = visopt::FieldView(f.phi);
+    behind.emplace("behind max", fg, c.precision);
+    s.behindMax = visopt::FrustumFieldView(*behind, frustum.dims);
+  }
+  const int64_t rays = int64_t(frustum.dims.x) * frustum.dims.y;
+  const bool fast = c.kernel == Kernel::Fast;
+  auto once = [&] {
+    if (!fast) return scan(s, rays);
+    if (frustum.dims.z <= visopt::kScanBufferCells)
+      return scan(visopt::FastVisibilityScan<visopt::kScanBufferCells>{s}, rays);
+    return scan(visopt::FastVisibilityScan<0>{s}, rays);
+  };
+  visopt::ScanSums sums = once();  // first touch of the frustum fields
+  for (auto _ : state) {
+    sums = once();
+    benchmark::DoNotOptimize(sums);
+  }
+  const double cells = double(rays) * frustum.dims.z;
+  const double b = double(visopt::bytesPerValue(c.precision));
+  const double bytes = 2.0 * double(f.grid.voxelCount()) * b + cells * b * (c.surface ? 2 : 1);
+  state.counters["cells_M"] = cells * 1e-6;
+  state.counters["ns_cell_core"] =
+      benchmark::Counter(cells / (1e9 * tbb::info::default_concurrency()),
+                         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["GBs"] =
+      benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  if (stream().triadGBs > 0)
+    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
+                                                benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["V"] = sums.gMu > 0 ? sums.gMuT / sums.gMu : 0.0;
+}
+
+std::vector<Case> cases() {
+  const char* env = std::getenv("VISOPT_BENCH_FULL");
+  const bool full = env && *env && std::string(env) != "0";
+  std::vector<Case> out;
+  for (int volume : {64, 128, 256})
+    for (int frustum : {256, 512, 0})
+      for (Precision p : {Precision::FP32, Precision::FP16})
+        for (bool surface : {false, true})
+          for (Kernel k : {Kernel::Reference, Kernel::Fast})
+            if (full || volume * frustum < 256 * 512) out.push_back({k, volume, frustum, p, surface});
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  for (const Case& c : cases())
+    benchmark::RegisterBenchmark(nameOf(c).c_str(), [c](benchmark::State& st) { runCase(st, c); })
+        ->UseRealTime()
+        ->MinTime(0.5)
+        ->Unit(benchmark::kMillisecond);
+  const size_t llc = visopt::bench::lastLevelCacheBytes();
+  const size_t arrayBytes = std::clamp<size_t>(2 * llc, size_t(256) << 20, size_t(1) << 30);
+  stream() = visopt::bench::runStreamProbe(arrayBytes, 5);
+  benchmark::AddCustomContext("stream_triad_GBs", std::to_string(stream().triadGBs));
+  benchmark::AddCustomContext("stream_copy_GBs", std::to_string(stream().copyGBs));
+  benchmark::AddCustomContext("backend", visopt::backendDescription());
+  benchmark::RunSpecifiedBenchmarks();
+  const visopt::bench::StreamResult after = visopt::bench::runStreamProbe(arrayBytes, 5);
+  std::printf("STREAM triad before %.2f GB/s, after %.2f GB/s (copy %.2f / %.2f)\n",
+              stream().triadGBs, after.triadGBs, stream().copyGBs, after.copyGBs);
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,7 +1,9 @@
 // The grid updates (paper 000 Eqs. 10-13: the visibility scan of one frustum grid) kernel by
-// kernel: the reference per-ray scan (kernels/visibility_scan.h) and the fast scan the optimiser
-// runs (kernels/visibility_scan_fast.h) on the same fields in the same run, against a STREAM-like
-// probe run in the same process.
+// kernel, on the same fields in the same run, against a STREAM-like probe run in the same
+// process: the reference per-ray scan (kernels/visibility_scan.h), the fast per-ray scan
+// (kernels/visibility_scan_fast.h, buffered: what a one-thread-per-ray backend runs) and the
+// tiled scan the CPU backend runs (host/visibility_scan_tiles.h). All three use the tiled layout
+// of the frustum fields (core/frustum_field.h).
 //
 // One benchmark per (kernel, volume N^3, view frustum F^2 or the light grid, precision, context
 // surface or not). The scene is synthetic and the same for every case: mu a smooth blob
@@ -30,6 +32,7 @@
 #include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "host/visibility_scan_tiles.h"
 #include "kernels/visibility_scan_fast.h"
 #include "stream_probe.h"
 #include "visopt/camera.h"
@@ -41,7 +44,7 @@ namespace {
 
 using visopt::Precision;
 
-enum class Kernel { Reference, Fast };
+enum class Kernel { Reference, PerRay, Tiled };
 
 struct Case {
   Kernel kernel;
@@ -52,8 +55,10 @@ struct Case {
 };
 
 std::string nameOf(const Case& c) {
-  return std::string("scan/") + (c.kernel == Kernel::Fast ? "fast" : "reference") +
-         "/vol:" + std::to_string(c.volume) +
+  const char* kernel = c.kernel == Kernel::Tiled    ? "tiled"
+                       : c.kernel == Kernel::PerRay ? "per-ray"
+                                                    : "reference";
+  return std::string("scan/") + kernel + "/vol:" + std::to_string(c.volume) +
          (c.frustum > 0 ? "/view:" + std::to_string(c.frustum) : std::string("/light:128")) + "/" +
          visopt::toString(c.precision) + (c.surface ? "/surface" : "/no-surface");
 }
@@ -100,8 +105,7 @@ visopt::FrustumGrid frustumFor(const Case& c, const visopt::GridSpec& grid) {
   if (c.frustum == 0) {
     visopt::PointLight light;
     light.position = glm::vec3(-1.5f, -2.f, 2.5f);
-    return visopt::FrustumGrid::forLight(light, bounds, glm::ivec3(128, 128, 0),
-                                         grid.minSpacing());
+    return visopt::FrustumGrid::forLight(light, bounds, glm::ivec3(128, 128, 0), grid.minSpacing());
   }
   visopt::Camera cam;
   cam.eye = glm::vec3(0.8f, -2.8f, 0.6f);
@@ -115,10 +119,9 @@ visopt::bench::StreamResult& stream() {
 
 template <class K>
 visopt::ScanSums scan(const K& kernel, int64_t rays) {
-  return visopt::exec::reduce("bench scan", rays, visopt::ScanSums{}, kernel,
-                              [](const visopt::ScanSums& a, const visopt::ScanSums& b) {
-                                return a + b;
-                              });
+  return visopt::exec::reduce(
+      "bench scan", rays, visopt::ScanSums{}, kernel,
+      [](const visopt::ScanSums& a, const visopt::ScanSums& b) { return a + b; });
 }
 
 void runCase(benchmark::State& state, const Case& c) {
@@ -141,12 +144,10 @@ void runCase(benchmark::State& state, const Case& c) {
     s.behindMax = visopt::FrustumFieldView(*behind, frustum.dims);
   }
   const int64_t rays = int64_t(frustum.dims.x) * frustum.dims.y;
-  const bool fast = c.kernel == Kernel::Fast;
   auto once = [&] {
-    if (!fast) return scan(s, rays);
-    if (frustum.dims.z <= visopt::kScanBufferCells)
-      return scan(visopt::FastVisibilityScan<visopt::kScanBufferCells>{s}, rays);
-    return scan(visopt::FastVisibilityScan<0>{s}, rays);
+    if (c.kernel == Kernel::Reference) return scan(s, rays);
+    if (c.kernel == Kernel::Tiled) return visopt::scanTilesOnHost("bench scan", s);
+    return scan(visopt::FastVisibilityScan<visopt::kScanBufferCells>{s}, rays);
   };
   visopt::ScanSums sums = once();  // first touch of the frustum fields
   for (auto _ : state) {
@@ -157,9 +158,9 @@ void runCase(benchmark::State& state, const Case& c) {
   const double b = double(visopt::bytesPerValue(c.precision));
   const double bytes = 2.0 * double(f.grid.voxelCount()) * b + cells * b * (c.surface ? 2 : 1);
   state.counters["cells_M"] = cells * 1e-6;
-  state.counters["ns_cell_core"] =
-      benchmark::Counter(cells / (1e9 * tbb::info::default_concurrency()),
-                         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["ns_cell_core"] = benchmark::Counter(
+      cells / (1e9 * tbb::info::default_concurrency()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["GBs"] =
       benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
   if (stream().triadGBs > 0)
@@ -176,8 +177,9 @@ std::vector<Case> cases() {
     for (int frustum : {256, 512, 0})
       for (Precision p : {Precision::FP32, Precision::FP16})
         for (bool surface : {false, true})
-          for (Kernel k : {Kernel::Reference, Kernel::Fast})
-            if (full || volume * frustum < 256 * 512) out.push_back({k, volume, frustum, p, surface});
+          for (Kernel k : {Kernel::Reference, Kernel::PerRay, Kernel::Tiled})
+            if (full || volume * frustum < 256 * 512)
+              out.push_back({k, volume, frustum, p, surface});
   return out;
 }
 

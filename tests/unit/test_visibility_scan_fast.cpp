@@ -2,7 +2,9 @@
 // reference per-ray scan (kernels/visibility_scan.h): the same d, the same running maximum of g
 // behind each cell (half of ghat, Eq. 19) and the same sums (energies, V, V_occ) to float
 // round-off, on small grids with and without context surfaces, a lens, a screen mask, view and
-// light frusta, fp32 and fp16, with the per-ray buffer and without it (the form CUDA compiles).
+// light frusta, fp32 and fp16: one ray per launch with the per-ray buffer and without it (the
+// form CUDA compiles), and the CPU backend's tiles of rays (host/visibility_scan_tiles.h; the
+// frusta are 26 and 21 rays wide, so their last tiles are partly padding).
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -13,6 +15,7 @@
 #include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "host/visibility_scan_tiles.h"
 #include "kernels/visibility_scan_fast.h"
 #include "visopt/camera.h"
 #include "visopt/field.h"
@@ -101,6 +104,11 @@ struct Result {
   ScanSums sums;
 };
 
+// The tiled CPU scan (host/visibility_scan_tiles.h), for run<>.
+struct TiledScan {
+  VisibilityScan scan;
+};
+
 template <class Kernel>
 Result run(const Scene& s, const Case& c) {
   GridSpec fg;
@@ -129,8 +137,11 @@ Result run(const Scene& s, const Case& c) {
   }
   if (c.behindMax) scan.behindMax = FrustumFieldView(behind, s.frustum.dims);
   Result r;
-  r.sums = exec::reduce("test scan", int64_t(s.frustum.dims.x) * s.frustum.dims.y, ScanSums{},
-                        kernel, [](const ScanSums& a, const ScanSums& b) { return a + b; });
+  if constexpr (std::is_same_v<Kernel, TiledScan>)
+    r.sums = scanTilesOnHost("test scan", scan);
+  else
+    r.sums = exec::reduce("test scan", int64_t(s.frustum.dims.x) * s.frustum.dims.y, ScanSums{},
+                          kernel, [](const ScanSums& a, const ScanSums& b) { return a + b; });
   const glm::ivec3 n = s.frustum.dims;
   for (int k = 0; k < n.z; ++k)
     for (int j = 0; j < n.y; ++j)
@@ -181,6 +192,7 @@ TEST(FastVisibilityScan, MatchesTheReferenceScan) {
           const Result ref = run<VisibilityScan>(s, c);
           expectSame(ref, run<FastVisibilityScan<kScanBufferCells>>(s, c), c, "buffered");
           expectSame(ref, run<FastVisibilityScan<0>>(s, c), c, "unbuffered");
+          expectSame(ref, run<TiledScan>(s, c), c, "tiled");
           ++cases;
         }
   EXPECT_EQ(cases, 36);
@@ -193,7 +205,7 @@ TEST(FastVisibilityScan, ASurfaceAroundTheVolumeHidesAll) {
   Scene s = makeScene(c);
   for (size_t v = 0; v < s.phi[0].size(); ++v) s.phi[0].set(v, -1.f);
   const Result ref = run<VisibilityScan>(s, c);
-  const Result fast = run<FastVisibilityScan<kScanBufferCells>>(s, c);
+  const Result fast = run<TiledScan>(s, c);
   EXPECT_EQ(fast.sums.gMuT, 0.0);
   EXPECT_EQ(fast.sums.importantSeen, 0.0);
   EXPECT_GT(fast.sums.gMu, 0.0);

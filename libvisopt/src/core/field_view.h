@@ -11,6 +11,7 @@
 
 #include "core/half.h"
 #include "core/hd.h"
+#include "core/min_max.h"
 #include "visopt/field.h"
 
 namespace visopt {
@@ -37,10 +38,11 @@ struct FieldView {
     return half ? halfToFloat(static_cast<const Half*>(data)[i])
                 : static_cast<const float*>(data)[i];
   }
-  // fp16 stores saturate at +-65504 (fp16's largest finite value) rather than overflow to inf.
+  // fp16 stores saturate at +-65504 (fp16's largest finite value) rather than overflow to inf;
+  // NaN stores as -65504, as fmaxf would.
   VISOPT_HD void store(size_t i, float v) const {
     if (half)
-      static_cast<Half*>(data)[i] = floatToHalf(fminf(fmaxf(v, -65504.f), 65504.f));
+      static_cast<Half*>(data)[i] = floatToHalf(minOf(maxOf(v, -65504.f), 65504.f));
     else
       static_cast<float*>(data)[i] = v;
   }

@@ -48,6 +48,17 @@ struct FrustumFieldView {
   VISOPT_HD VISOPT_INLINE float load(size_t c) const { return storage.load(c); }
   VISOPT_HD VISOPT_INLINE void store(size_t c, float v) const { storage.store(c, v); }
   VISOPT_HD VISOPT_INLINE float at(int i, int j, int k) const { return load(index(i, j, k)); }
+  // Stores kTileRays values at `first` = index(i, j, k) of a tile's first ray i: one tile row at
+  // one depth, contiguous, with one precision test (fp16 saturates as FieldView::store).
+  VISOPT_HD VISOPT_INLINE void storeRow(size_t first, const float* v) const {
+    if (storage.half) {
+      Half* h = static_cast<Half*>(storage.data) + first;
+      for (int l = 0; l < kTileRays; ++l) h[l] = floatToHalf(minOf(maxOf(v[l], -65504.f), 65504.f));
+    } else {
+      float* f = static_cast<float*>(storage.data) + first;
+      for (int l = 0; l < kTileRays; ++l) f[l] = v[l];
+    }
+  }
 
   // Trilinear interpolation at continuous frustum coordinates (cell centres at integers),
   // clamped to the grid as FieldView::sample clamps, in its order of operations. The eight

@@ -79,16 +79,87 @@ struct TrilinearCorners {
   }
 };
 
-// Rays of up to this many depth cells are scanned with the per-ray buffer (3 floats per cell on
-// the stack: 48 KiB, well inside a oneTBB worker's stack). One cell per half voxel covers a
+// One ray's geometry: its origin and direction in index space (cell k's centre is o + depth(k)
+// d), its screen weight and its pixel's solid angle.
+struct ScanRay {
+  glm::vec3 o, d;
+  float w, omega;
+};
+
+VISOPT_HD VISOPT_INLINE ScanRay scanRayOf(const VisibilityScan& scan, int i, int j) {
+  const FrustumMap& f = scan.frustum;
+  ScanRay r;
+  r.o = scan.volume.toIndex(f.eye);
+  r.d = scan.volume.directionToIndex(f.rayDirection(float(i), float(j)));
+  r.w = scan.weights.active() ? scan.weights.at(i, j, f.dims.x, f.dims.y) : 1.f;
+  r.omega = scan.solidAngle(i, j);
+  return r;
+}
+
+// The front-to-back pass of one ray: exclusive transmittance T; a surface blocks everything from
+// its first cell. Hands each cell's mu, g (unweighted) and T to cell(k, m, g, t) and adds the
+// ray's V_occ terms to sums.
+template <class CellSink>
+VISOPT_HD VISOPT_INLINE void frontToBack(const VisibilityScan& scan, const ScanRay& ray,
+                                         ScanSums& sums, CellSink&& cell) {
+  const FrustumMap& frustum = scan.frustum;
+  const int nz = frustum.dims.z;
+  const float ds = frustum.ds;
+  const glm::ivec3 dims = scan.mu.dims;
+  const glm::vec3 hi = glm::vec3(scan.volume.dims) - 0.5f;
+  float opticalDepth = 0.f, importantDepth = 0.f;
+  float t = 1.f, tDepth = 0.f;  // t = exp(-tDepth), recomputed when the optical depth moves
+  bool blocked = false;
+  for (int k = 0; k < nz; ++k) {
+    const float depth = frustum.depthOf(float(k));
+    const glm::vec3 idx = ray.o + depth * ray.d;
+    // The volume occupies its voxels' cells, [-0.5, dims - 0.5] in index space (sampleAt).
+    const bool in = idx.x >= -0.5f && idx.y >= -0.5f && idx.z >= -0.5f && idx.x <= hi.x &&
+                    idx.y <= hi.y && idx.z <= hi.z;
+    float m = 0.f, g = 0.f, gm = 0.f;  // gm: the interpolated product g_v mu_v
+    if (in) {
+      const TrilinearCorners corners(idx, dims);
+      float muC[8], gC[8];
+      corners.load(scan.mu, muC);
+      corners.load(scan.importance, gC);
+      m = corners.interpolate(muC);
+      g = corners.interpolate(gC);
+      if (g > 0.f) gm = corners.interpolateProduct(muC, gC);
+      for (int s = 0; s < scan.surfaces.count && !blocked; ++s) {
+        float phiC[8];
+        corners.load(scan.surfaces.phi[s], phiC);
+        blocked = corners.interpolate(phiC) < 0.f;
+      }
+    }
+    if (!blocked && opticalDepth != tDepth) {
+      tDepth = opticalDepth;
+      t = expf(-opticalDepth);
+    }
+    const float tCell = blocked ? 0.f : t;
+    cell(k, m, g, tCell);
+    opticalDepth += m * ds;
+    if (in && g > 0.f) {
+      // The statistic V_occ (ScanSums): screen weights scale importance as in the energy.
+      gm *= minOf(ray.w, 1.f / maxOf(g, 1e-30f));
+      const double dV = double(ray.omega) * double(depth) * double(depth) * double(ds);
+      sums.importantSeen += double(gm * tCell) * dV;
+      sums.importantSeenAlone += double(gm * expf(-importantDepth)) * dV;
+      importantDepth += gm * ds;
+    }
+  }
+}
+
+// Rays of up to this many depth cells are scanned with a buffer (per ray: 3 floats per cell on
+// the stack, 48 KiB, well inside a oneTBB worker's stack). One cell per half voxel covers a
 // 1180-voxel diagonal.
 constexpr int kScanBufferCells = 4096;
 
+// One ray per launch.
 template <int kBufferedCells>
 struct FastVisibilityScan {
   VisibilityScan scan;  // the inputs, as for the reference
 
-  VISOPT_HD ScanSums operator()(int64_t ray) const {
+  VISOPT_HD ScanSums operator()(int64_t rayIndex) const {
 #if defined(__CUDA_ARCH__)
     constexpr int kBuffer = 0;
 #else
@@ -96,76 +167,30 @@ struct FastVisibilityScan {
 #endif
     const FrustumMap& frustum = scan.frustum;
     const FrustumFieldView& out = scan.out;
-    const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
-    const int nz = frustum.dims.z;
-    const float ds = frustum.ds;
-    const glm::vec3 o = scan.volume.toIndex(frustum.eye);
-    const glm::vec3 d = scan.volume.directionToIndex(frustum.rayDirection(float(i), float(j)));
-    const float w =
-        scan.weights.active() ? scan.weights.at(i, j, frustum.dims.x, frustum.dims.y) : 1.f;
-    const float omega = scan.solidAngle(i, j);
+    const int i = int(rayIndex % frustum.dims.x), j = int(rayIndex / frustum.dims.x);
+    const ScanRay ray = scanRayOf(scan, i, j);
     const glm::ivec3 dims = scan.mu.dims;
     const glm::vec3 hi = glm::vec3(scan.volume.dims) - 0.5f;
-    // The volume occupies its voxels' cells, [-0.5, dims - 0.5] in index space (sampleAt).
-    auto inside = [&](glm::vec3 p) {
-      return p.x >= -0.5f && p.y >= -0.5f && p.z >= -0.5f && p.x <= hi.x && p.y <= hi.y &&
-             p.z <= hi.z;
-    };
 
     float mBuf[kBuffer > 0 ? kBuffer : 1], gBuf[kBuffer > 0 ? kBuffer : 1],
         tBuf[kBuffer > 0 ? kBuffer : 1];
-
-    // Front to back: exclusive transmittance; a surface blocks everything from its first cell.
     ScanSums sums;
-    float opticalDepth = 0.f, importantDepth = 0.f;
-    float t = 1.f, tDepth = 0.f;  // t = exp(-tDepth), recomputed when the optical depth moves
-    bool blocked = false;
-    for (int k = 0; k < nz; ++k) {
-      const float depth = frustum.depthOf(float(k));
-      const glm::vec3 idx = o + depth * d;
-      const bool in = inside(idx);
-      float m = 0.f, g = 0.f, gm = 0.f;  // gm: the interpolated product g_v mu_v
-      if (in) {
-        const TrilinearCorners corners(idx, dims);
-        float muC[8], gC[8];
-        corners.load(scan.mu, muC);
-        corners.load(scan.importance, gC);
-        m = corners.interpolate(muC);
-        g = corners.interpolate(gC);
-        if (g > 0.f) gm = corners.interpolateProduct(muC, gC);
-        for (int s = 0; s < scan.surfaces.count && !blocked; ++s) {
-          float phiC[8];
-          corners.load(scan.surfaces.phi[s], phiC);
-          blocked = corners.interpolate(phiC) < 0.f;
-        }
-      }
-      if (!blocked && opticalDepth != tDepth) {
-        tDepth = opticalDepth;
-        t = expf(-opticalDepth);
-      }
-      const float tCell = blocked ? 0.f : t;
+    frontToBack(scan, ray, sums, [&](int k, float m, float g, float t) {
       if constexpr (kBuffer > 0) {
         mBuf[k] = m;
         gBuf[k] = g;
         // What the reference reads back from the frustum field (fp16 rounds it).
-        tBuf[k] = out.half() ? halfToFloat(floatToHalf(tCell)) : tCell;
+        tBuf[k] = out.half() ? halfToFloat(floatToHalf(t)) : t;
       } else {
-        out.store(out.index(i, j, k), tCell);
+        out.store(out.index(i, j, k), t);
       }
-      opticalDepth += m * ds;
-      if (in && g > 0.f) {
-        // The statistic V_occ (ScanSums): screen weights scale importance as in the energy.
-        gm *= minOf(w, 1.f / maxOf(g, 1e-30f));
-        const double dV = double(omega) * double(depth) * double(depth) * double(ds);
-        sums.importantSeen += double(gm * tCell) * dV;
-        sums.importantSeenAlone += double(gm * expf(-importantDepth)) * dV;
-        importantDepth += gm * ds;
-      }
-    }
+    });
+
     // Back to front: G (behind, weighted by s^2) and d = g T - G.
+    const float ds = frustum.ds;
     float behind = 0.f;      // sum_{j>k} g mu T s^2 ds
     float runningMax = 0.f;  // max_{j>k} g
-    for (int k = nz - 1; k >= 0; --k) {
+    for (int k = frustum.dims.z - 1; k >= 0; --k) {
       const float s = frustum.depthOf(float(k));
       const size_t c = out.index(i, j, k);
       float m = 0.f, g = 0.f, tCell;
@@ -174,8 +199,9 @@ struct FastVisibilityScan {
         g = gBuf[k];
         tCell = tBuf[k];
       } else {
-        const glm::vec3 idx = o + s * d;
-        if (inside(idx)) {
+        const glm::vec3 idx = ray.o + s * ray.d;
+        if (idx.x >= -0.5f && idx.y >= -0.5f && idx.z >= -0.5f && idx.x <= hi.x && idx.y <= hi.y &&
+            idx.z <= hi.z) {
           const TrilinearCorners corners(idx, dims);
           float v[8];
           corners.load(scan.mu, v);
@@ -185,7 +211,7 @@ struct FastVisibilityScan {
         }
         tCell = out.load(c);
       }
-      g = minOf(g * w, 1.f);
+      g = minOf(g * ray.w, 1.f);
       if (scan.behindMax.valid()) {
         scan.behindMax.store(scan.behindMax.index(i, j, k), runningMax);
         runningMax = maxOf(runningMax, g);
@@ -194,7 +220,7 @@ struct FastVisibilityScan {
       out.store(c, g * tCell - behind / s2);
       const float gmt = g * m * tCell;
       behind += gmt * s2 * ds;
-      const double dV = double(omega) * double(s2) * double(ds);
+      const double dV = double(ray.omega) * double(s2) * double(ds);
       sums.gMuT += double(gmt) * dV;
       sums.gMu += double(g * m) * dV;
     }

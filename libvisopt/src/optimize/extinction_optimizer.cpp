@@ -10,6 +10,7 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "host/visibility_scan_tiles.h"
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan_fast.h"
 #include "optimize/level_set.h"
@@ -64,9 +65,10 @@ ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& 
   }
   const int64_t rays = int64_t(frustum.dims.x) * frustum.dims.y;
   auto sum = [] VISOPT_HD(const ScanSums& a, const ScanSums& b) { return a + b; };
-  if (frustum.dims.z <= kScanBufferCells)
-    return exec::reduce(name, rays, ScanSums{}, FastVisibilityScan<kScanBufferCells>{scan}, sum);
-  return exec::reduce(name, rays, ScanSums{}, FastVisibilityScan<0>{scan}, sum);
+  if (frustum.dims.z > kScanBufferCells)
+    return exec::reduce(name, rays, ScanSums{}, FastVisibilityScan<0>{scan}, sum);
+  if (activeBackend() == Backend::CPU) return scanTilesOnHost(name, scan);
+  return exec::reduce(name, rays, ScanSums{}, FastVisibilityScan<kScanBufferCells>{scan}, sum);
 }
 
 ExtinctionGradient gradientOf(const ExtinctionProblem& p, const Field3D* dView,

@@ -1,6 +1,9 @@
 // The 16-bit storage type: the same 16 bits on host and device, converted at load and store.
-// nvcc crashes on _Float16 in device code, so device (and any nvcc-compiled) code converts with
-// cuda_fp16's intrinsics; plain g++ uses _Float16, a single F16C instruction with -march=native.
+// nvcc crashes on _Float16 in device code, so device code converts with cuda_fp16's intrinsics;
+// plain g++ uses _Float16, a single F16C instruction with -march=native. The host side of an
+// nvcc-compiled translation unit uses that instruction through its intrinsic when the host
+// compiler targets F16C (cuda_fp16's host functions convert in software, which made the CPU path
+// of CUDA-enabled builds slower on fp16 fields).
 #pragma once
 
 #include <cstdint>
@@ -10,6 +13,10 @@
 
 #if defined(__CUDACC__)
 #include <cuda_fp16.h>
+#if !defined(__CUDA_ARCH__) && defined(__F16C__)
+#include <immintrin.h>
+#define VISOPT_HOST_F16C 1
+#endif
 #endif
 
 namespace visopt {
@@ -19,7 +26,9 @@ struct Half {
 };
 
 VISOPT_HD inline float halfToFloat(Half h) {
-#if defined(__CUDACC__)
+#if defined(VISOPT_HOST_F16C) && !defined(__CUDA_ARCH__)
+  return _cvtsh_ss(h.bits);
+#elif defined(__CUDACC__)
   __half_raw raw;
   raw.x = h.bits;
   return __half2float(__half(raw));
@@ -33,7 +42,9 @@ VISOPT_HD inline float halfToFloat(Half h) {
 // Round to nearest even; values beyond fp16's range become +-inf, which callers avoid by
 // storing normalised or bounded quantities only.
 VISOPT_HD inline Half floatToHalf(float v) {
-#if defined(__CUDACC__)
+#if defined(VISOPT_HOST_F16C) && !defined(__CUDA_ARCH__)
+  return Half{static_cast<uint16_t>(_cvtss_sh(v, _MM_FROUND_TO_NEAREST_INT))};
+#elif defined(__CUDACC__)
   __half_raw raw = __half_raw(__float2half_rn(v));
   return Half{raw.x};
 #else

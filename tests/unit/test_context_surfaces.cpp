@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "occluder_scene.h"
 #include "visopt/engine.h"
@@ -198,4 +199,75 @@ TEST(ContextSurfaces, TheImportanceBehindDoesNotChangeAsTheSurfaceOpens) {
   size_t changed = 0;
   for (size_t v = 0; v < b->size(); ++v) changed += kept.importanceBehind()->get(v) != b->get(v);
   EXPECT_GT(changed, b->size() / 100);
+}
+
+namespace {
+
+std::vector<float> valuesOf(const Field3D& f) {
+  std::vector<float> v(f.size());
+  for (size_t i = 0; i < f.size(); ++i) v[i] = f.get(i);
+  return v;
+}
+
+// Runs `body` on one thread, so that parallel sums (and what depends on them) repeat bit for bit
+// from run to run.
+template <class F>
+void singleThreaded(F body) {
+  tbb::task_arena arena(1);
+  arena.execute(body);
+}
+
+}  // namespace
+
+// What the workstation does when the camera moves mid-iteration (Engine::continueOptimization's
+// `abandon`): an iteration abandoned after its grid updates changes nothing, bit for bit: not
+// mu, not phi, and not the optimiser's moments and step count, which the next iteration would
+// show (it matches, bit for bit, the next iteration of a twin engine that never had the
+// abandoned one).
+TEST(ContextSurfaces, AnAbandonedIterationChangesNothing) {
+  singleThreaded([] {
+    Engine a, twin;
+    for (Engine* e : {&a, &twin}) {
+      setup(*e);
+      ExtinctionSettings s = e->extinctionSettings();
+      s.maxIterationsPerLevel = s.minIterationsPerLevel = 4;
+      e->setExtinctionSettings(s);
+      e->optimize();
+    }
+    const std::vector<float> mu = valuesOf(*a.optimizedExtinction());
+    const std::vector<float> phi = valuesOf(*a.contextSurfacePhi(0));
+    int polls = 0;
+    // Polled at the iteration's start and after its grid updates: abandon at the second poll.
+    const auto stats = a.continueOptimization(1, {}, [&] { return ++polls == 2; });
+    EXPECT_TRUE(stats.empty());
+    EXPECT_EQ(polls, 2);
+    EXPECT_EQ(valuesOf(*a.optimizedExtinction()), mu);
+    EXPECT_EQ(valuesOf(*a.contextSurfacePhi(0)), phi);
+
+    const auto next = a.continueOptimization(1);
+    const auto twinNext = twin.continueOptimization(1);
+    ASSERT_EQ(next.size(), 1u);
+    ASSERT_EQ(twinNext.size(), 1u);
+    EXPECT_NE(valuesOf(*a.optimizedExtinction()), mu) << "the next iteration did change mu";
+    EXPECT_EQ(valuesOf(*a.optimizedExtinction()), valuesOf(*twin.optimizedExtinction()));
+    EXPECT_EQ(valuesOf(*a.contextSurfacePhi(0)), valuesOf(*twin.contextSurfacePhi(0)));
+    EXPECT_EQ(next[0].energy(), twinNext[0].energy());
+  });
+}
+
+// Asked to stop during the level-set substeps, an iteration ends at the next chunk with fewer
+// substeps and is reported; the call returns after it.
+TEST(ContextSurfaces, AnIterationAskedToStopDuringTheSurfaceStepEndsEarly) {
+  Engine e;
+  setup(e);
+  ExtinctionSettings s = e.extinctionSettings();
+  s.maxIterationsPerLevel = s.minIterationsPerLevel = 2;
+  e.setExtinctionSettings(s);
+  const auto full = e.optimize();
+  ASSERT_FALSE(full.empty());
+  int polls = 0;
+  const auto cut = e.continueOptimization(5, {}, [&] { return ++polls >= 4; });
+  ASSERT_EQ(cut.size(), 1u);
+  EXPECT_LT(cut[0].levelSetSubsteps, full.back().levelSetSubsteps);
+  EXPECT_EQ(e.continueOptimization(1).size(), 1u) << "and the optimisation carries on";
 }

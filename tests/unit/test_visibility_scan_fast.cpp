@@ -28,11 +28,12 @@ namespace {
 enum class Weights { None, Lens, Mask };
 
 struct Case {
-  Precision precision;
-  int surfaces;  // 0, 1 or 2 spheres
+  Precision precision;  // of every field, except the importance with mixedImportance
+  int surfaces;         // 0, 1 or 2 spheres
   Weights weights;
   bool lightFrustum;
   bool behindMax;
+  bool mixedImportance = false;  // g in fp32 whatever the others' precision
   std::string name() const {
     return std::string(precision == Precision::FP16 ? "fp16" : "fp32") + "_surfaces" +
            std::to_string(surfaces) +
@@ -57,7 +58,7 @@ Scene makeScene(const Case& c) {
   s.grid.spacing = glm::vec3(0.05f, 0.06f, 0.055f);
   s.grid.origin = -0.5f * glm::vec3(s.grid.dims - 1) * s.grid.spacing;
   s.mu = Field3D("mu", s.grid, c.precision);
-  s.g = Field3D("g", s.grid, c.precision);
+  s.g = Field3D("g", s.grid, c.mixedImportance ? Precision::FP32 : c.precision);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> u(0.f, 1.f);
   const glm::ivec3 n = s.grid.dims;
@@ -196,6 +197,17 @@ TEST(FastVisibilityScan, MatchesTheReferenceScan) {
           ++cases;
         }
   EXPECT_EQ(cases, 36);
+}
+
+// Fields of mixed precision: the tiled scan's per-ray front-to-back pass (its lanes pass needs
+// one precision throughout).
+TEST(FastVisibilityScan, MixedPrecisionMatchesTheReferenceScan) {
+  for (int surfaces : {0, 2}) {
+    Case c{Precision::FP16, surfaces, Weights::Lens, false, true};
+    c.mixedImportance = true;
+    const Scene s = makeScene(c);
+    expectSame(run<VisibilityScan>(s, c), run<TiledScan>(s, c), c, "tiled, mixed precision");
+  }
 }
 
 // A surface in front of everything blocks every ray from its first cell: d and T vanish behind

@@ -299,23 +299,28 @@ void EngineController::optimizeStep(Engine& engine) {
   if (restart) {
     engine.resetOptimization();
     bool interrupted = false;
-    engine.optimize([&](const IterationStats& st) {
-      report(st);
-      if (sinceFrame_.elapsed() > kFrameIntervalMs) renderFrame(engine, false);
-      interrupted = interrupt();
-      return !interrupted;
-    });
+    engine.optimize(
+        [&](const IterationStats& st) {
+          report(st);
+          if (sinceFrame_.elapsed() > kFrameIntervalMs) renderFrame(engine, false);
+          interrupted = interrupt();
+          return !interrupted;
+        },
+        [&] { return interrupted = interrupt(); });
     // The coarse-to-fine schedule ran to its end (each level to its tolerance or cap).
     if (!interrupted) settle();
     std::lock_guard lock(mutex_);
     frameOwed_ = true;
     return;
   }
-  const auto stats = engine.continueOptimization(1);
-  if (stats.empty()) {  // frozen
+  if (engine.frozen()) {
     converged_ = true;
     return;
   }
+  // A newer camera or edit abandons the iteration in flight (it changes nothing), so the worker
+  // answers it at once instead of after a whole iteration.
+  const auto stats = engine.continueOptimization(1, {}, interrupt);
+  if (stats.empty()) return;  // abandoned
   report(stats.back());
   const double e = stats.back().energy();
   const double rel = std::abs(e - lastEnergy_) / std::max(std::abs(e), 1e-30);

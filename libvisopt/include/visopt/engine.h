@@ -115,12 +115,21 @@ class Engine {
   void setViewportSize(int width, int height);
   glm::ivec2 viewportSize() const;
   // Coarse to fine from mu_bar. The callback sees every iteration; returning false stops.
+  // `abandon` (optional) is polled between the stages of every iteration, for an interface that
+  // must answer a newer camera or edit at once: when it returns true before the iteration's
+  // extinction step, that iteration is abandoned and changes nothing (mu, the surfaces and the
+  // optimiser state stay bit for bit), and the call returns the iterations done before it; when
+  // it returns true during the surfaces' level-set substeps, they stop at the next chunk (the
+  // iteration ends with fewer substeps, a consistent state) and the call returns after it.
   std::vector<IterationStats> optimize(
-      const std::function<bool(const IterationStats&)>& callback = {});
+      const std::function<bool(const IterationStats&)>& callback = {},
+      const std::function<bool()>& abandon = {});
   // Continues at the finest level from the current mu, for the current camera and light (warm
   // start: what the workstation runs while the user navigates). Does nothing while frozen.
+  // `abandon` as for optimize().
   std::vector<IterationStats> continueOptimization(
-      int iterations, const std::function<bool(const IterationStats&)>& callback = {});
+      int iterations, const std::function<bool(const IterationStats&)>& callback = {},
+      const std::function<bool()>& abandon = {});
   // A frozen result keeps its mu when the camera moves (paper 000 §III-F, Fig. 7).
   void setFrozen(bool frozen);
   bool frozen() const;

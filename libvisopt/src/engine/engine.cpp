@@ -494,19 +494,21 @@ glm::ivec2 Engine::viewportSize() const {
 }
 
 std::vector<IterationStats> Engine::optimize(
-    const std::function<bool(const IterationStats&)>& callback) {
+    const std::function<bool(const IterationStats&)>& callback,
+    const std::function<bool()>& abandon) {
   if (impl_->frozen) return {};
   auto stats = impl_->optimizer.runMultigrid(impl_->optimizationInputs(), impl_->extinctionSettings,
-                                             callback);
+                                             callback, abandon);
   impl_->lightDirty = true;
   return stats;
 }
 
 std::vector<IterationStats> Engine::continueOptimization(
-    int iterations, const std::function<bool(const IterationStats&)>& callback) {
+    int iterations, const std::function<bool(const IterationStats&)>& callback,
+    const std::function<bool()>& abandon) {
   if (impl_->frozen || iterations <= 0) return {};
   auto stats = impl_->optimizer.iterate(impl_->optimizationInputs(), impl_->extinctionSettings,
-                                        iterations, callback);
+                                        iterations, callback, abandon);
   impl_->lightDirty = true;
   return stats;
 }

@@ -432,8 +432,11 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
   (void)s;
 }
 
-IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
-                                                 const ExtinctionSettings& s, int levels, int cap) {
+std::optional<IterationStats> ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
+                                                                const ExtinctionSettings& s,
+                                                                int levels, int cap) {
+  cutShort_ = false;
+  if (abandonRequested()) return std::nullopt;
   Level& L = *level_;
   const int shrink = L.shrink;
   (void)levels;
@@ -497,6 +500,9 @@ IterationStats ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
   else
     L.lightMax.reset();
   st.gridUpdatesMs = msSince(t0);
+  // The last point where the iteration can still be abandoned: nothing but scratch (the frustum
+  // fields) has changed yet.
+  if (abandonRequested()) return std::nullopt;
 
   // Optimiser state, allocated on the first step of a level.
   const bool ademamix = s.optimizer == OptimizerKind::AdEMAMix;
@@ -666,8 +672,14 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   int chunk = std::max(in.levelSet.substeps, 1);
   LevelSetStepStats ls;
   L.lastMotion = 0.0;
+  int substepsDone = 0;
   for (int done = 0; done < std::max(L.substeps, 1); done += chunkSettings.substeps) {
+    if (abandonRequested()) {  // cut short: phi after fewer substeps is a consistent state
+      cutShort_ = true;
+      break;
+    }
     chunkSettings.substeps = std::min(chunk, std::max(L.substeps, 1) - done);
+    substepsDone += chunkSettings.substeps;
     auto ts = Clock::now();
     double motion = 0.0, insideRise = 0.0, rate = 0.0;
     bool anySurface = false;
@@ -719,7 +731,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   }
   for (const NarrowBand& b : L.bands) st.bandVoxels += b.band().voxels;
   st.levelSetTimeStep = ls.timeStep;
-  st.levelSetSubsteps = std::max(L.substeps, 1);
+  st.levelSetSubsteps = substepsDone;
   st.levelSetMotionVoxels = L.lastMotion / h;
   for (size_t si = 0; si < L.phi.size(); ++si)
     st.levelSetCrossedVoxels += crossedSince(L.phi[si], L.insideAtStart[si]);
@@ -773,8 +785,14 @@ void validate(const OptimizationInputs& in, const ExtinctionSettings& s) {
 
 std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const OptimizationInputs& in,
                                                               const ExtinctionSettings& s,
-                                                              const IterationCallback& callback) {
+                                                              const IterationCallback& callback,
+                                                              const AbandonCheck& abandon) {
   validate(in, s);
+  abandon_ = &abandon;
+  struct Clear {
+    const AbandonCheck*& p;
+    ~Clear() { p = nullptr; }
+  } clear{abandon_};
   level_.reset();
   std::vector<IterationStats> all;
   for (int l = 0; l < s.levels; ++l) {
@@ -782,9 +800,13 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
     double last = 0.0;
     std::optional<IterationStats> previous;
     for (int it = 0; it < s.maxIterationsPerLevel; ++it) {
-      IterationStats st = runIteration(in, s, s.levels, s.maxIterationsPerLevel);
+      const std::optional<IterationStats> done =
+          runIteration(in, s, s.levels, s.maxIterationsPerLevel);
+      if (!done) return all;
+      const IterationStats& st = *done;
       all.push_back(st);
       if (callback && !callback(st)) return all;
+      if (cutShort_) return all;
       const double e = st.energy();
       const double rel = std::abs(e - last) / std::max(std::abs(e), 1e-30);
       last = e;
@@ -814,17 +836,26 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
 std::vector<IterationStats> ExtinctionOptimizer::iterate(const OptimizationInputs& in,
                                                          const ExtinctionSettings& s,
                                                          int iterations,
-                                                         const IterationCallback& callback) {
+                                                         const IterationCallback& callback,
+                                                         const AbandonCheck& abandon) {
   validate(in, s);
+  abandon_ = &abandon;
+  struct Clear {
+    const AbandonCheck*& p;
+    ~Clear() { p = nullptr; }
+  } clear{abandon_};
   if (!level_ || !level_->finest || level_->grid.dims != in.volume->grid().dims)
     buildLevel(in, s, 0, 1);  // start at the finest grid from mu_bar
   std::vector<IterationStats> all;
   for (int it = 0; it < iterations; ++it) {
     level_->ghatFixed = false;  // the camera, light or importance may have changed meanwhile
-    IterationStats st = runIteration(in, s, 1, std::max(iterations, s.maxIterationsPerLevel));
-    st.level = level_->index;
-    all.push_back(st);
-    if (callback && !callback(st)) break;
+    std::optional<IterationStats> st =
+        runIteration(in, s, 1, std::max(iterations, s.maxIterationsPerLevel));
+    if (!st) break;
+    st->level = level_->index;
+    all.push_back(*st);
+    if (callback && !callback(*st)) break;
+    if (cutShort_) break;
   }
   return all;
 }

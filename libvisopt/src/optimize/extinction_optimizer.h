@@ -39,6 +39,8 @@ struct OptimizationInputs {
 
 // Returning false from the callback stops the run after that iteration.
 using IterationCallback = std::function<bool(const IterationStats&)>;
+// Polled between the stages of an iteration (Engine::continueOptimization).
+using AbandonCheck = std::function<bool()>;
 
 // The discrete problem on one grid; used by the optimiser and by the gradient tests.
 struct ExtinctionProblem {
@@ -72,13 +74,20 @@ class ExtinctionOptimizer {
   // Coarse to fine from mu_bar: each level runs to its tolerance or iteration cap, then mu is
   // prolonged to the next level; the optimiser state restarts at every level (its moments
   // describe the coarse grid's gradients, which do not transfer).
+  // `abandon` (may be empty) is polled between the stages of every iteration: true before the
+  // extinction step abandons the iteration in flight, which then changes nothing (mu, phi, the
+  // optimiser's moments and step count stay bit for bit), and ends the call; true during the
+  // level-set substeps ends them at the next chunk (fewer substeps: a consistent state) and the
+  // call after that iteration.
   std::vector<IterationStats> runMultigrid(const OptimizationInputs& in,
                                            const ExtinctionSettings& settings,
-                                           const IterationCallback& callback);
+                                           const IterationCallback& callback,
+                                           const AbandonCheck& abandon = {});
   // Continues at the finest level from the current mu (warm start, e.g. after the camera moved).
   std::vector<IterationStats> iterate(const OptimizationInputs& in,
                                       const ExtinctionSettings& settings, int iterations,
-                                      const IterationCallback& callback);
+                                      const IterationCallback& callback,
+                                      const AbandonCheck& abandon = {});
   // The optimised extinction on the volume grid, or null before any run.
   const Field3D* extinction() const;
   // The optimised context surfaces phi on the volume grid (one per base), empty before any run.
@@ -91,14 +100,20 @@ class ExtinctionOptimizer {
   struct Level;
   void buildLevel(const OptimizationInputs& in, const ExtinctionSettings& settings, int level,
                   int levels);
-  IterationStats runIteration(const OptimizationInputs& in, const ExtinctionSettings& settings,
-                              int levels, int cap);
+  // Empty when abandoned (see runMultigrid).
+  std::optional<IterationStats> runIteration(const OptimizationInputs& in,
+                                             const ExtinctionSettings& settings, int levels,
+                                             int cap);
   void surfaceStep(const OptimizationInputs& in, Level& level, IterationStats& stats);
 
  private:
+  bool abandonRequested() const { return abandon_ && *abandon_ && (*abandon_)(); }
+
   MemoryLedger* ledger_;
   Precision precision_;
   std::unique_ptr<Level> level_;
+  const AbandonCheck* abandon_ = nullptr;  // during runMultigrid / iterate
+  bool cutShort_ = false;                  // the last iteration's level-set steps were cut short
 };
 
 }  // namespace visopt

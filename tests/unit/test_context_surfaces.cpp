@@ -237,10 +237,11 @@ TEST(ContextSurfaces, AnAbandonedIterationChangesNothing) {
     const std::vector<float> mu = valuesOf(*a.optimizedExtinction());
     const std::vector<float> phi = valuesOf(*a.contextSurfacePhi(0));
     int polls = 0;
-    // Polled at the iteration's start and after its grid updates: abandon at the second poll.
-    const auto stats = a.continueOptimization(1, {}, [&] { return ++polls == 2; });
+    // Polled at the iteration's start, after the view scan and after the light scan: abandon
+    // at the third poll, the last before the extinction step.
+    const auto stats = a.continueOptimization(1, {}, [&] { return ++polls == 3; });
     EXPECT_TRUE(stats.empty());
-    EXPECT_EQ(polls, 2);
+    EXPECT_EQ(polls, 3);
     EXPECT_EQ(valuesOf(*a.optimizedExtinction()), mu);
     EXPECT_EQ(valuesOf(*a.contextSurfacePhi(0)), phi);
 
@@ -266,6 +267,7 @@ TEST(ContextSurfaces, AnIterationAskedToStopDuringTheSurfaceStepEndsEarly) {
   const auto full = e.optimize();
   ASSERT_FALSE(full.empty());
   int polls = 0;
+  // The fourth poll is the first before a chunk of substeps.
   const auto cut = e.continueOptimization(5, {}, [&] { return ++polls >= 4; });
   ASSERT_EQ(cut.size(), 1u);
   EXPECT_LT(cut[0].levelSetSubsteps, full.back().levelSetSubsteps);

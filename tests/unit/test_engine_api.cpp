@@ -1,5 +1,6 @@
 // Engine facade additions the workstation uses: removing a context surface, recolouring one,
-// and reading back the render-optimised flag and the viewport size.
+// reading back the render-optimised flag and the viewport size, a render that gives way to a
+// newer camera, and previews that reuse the light transmittance while the optimisation runs.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -138,4 +139,53 @@ TEST(EngineApi, RenderOptimizedAndViewportSizeReadBack) {
     EXPECT_EQ(err.kind(), ErrorKind::Usage);
   }
   EXPECT_EQ(e.viewportSize(), glm::ivec2(320, 200));
+}
+
+// A render asked to stop returns an empty image, at its start or between bands; one never asked
+// renders exactly what a render without the check renders.
+TEST(EngineApi, ARenderGivesWayWhenAskedAndIsUnchangedOtherwise) {
+  Engine e;
+  emptyScene(e);
+  e.addContextSurface(specNamed("ball", glm::vec3(0.8f, 0.4f, 0.2f)),
+                      sphereSdf(e.volume().grid(), glm::vec3(0.f), 8.f));
+  const RenderSettings s = surfaceOnly();
+  const Image plain = e.render(s);
+  EXPECT_EQ(e.render(s, nullptr, [] { return true; }).width, 0);
+  int polls = 0;
+  EXPECT_EQ(e.render(s, nullptr, [&] { return ++polls == 3; }).width, 0);
+  EXPECT_EQ(polls, 3) << "stopped between bands";
+  polls = 0;
+  const Image asked = e.render(s, nullptr, [&] { return ++polls < 0; });
+  EXPECT_GT(polls, 2);
+  ASSERT_EQ(asked.width, plain.width);
+  ASSERT_EQ(asked.height, plain.height);
+  for (size_t i = 0; i < plain.pixels.size(); ++i) ASSERT_EQ(asked.pixels[i], plain.pixels[i]);
+}
+
+// After an optimisation iteration a full frame recomputes the light transmittance T_L; a
+// preview reuses the last full frame's once there is one of the optimised scene
+// (RenderStats::lightMilliseconds is 0 when T_L was not recomputed).
+TEST(EngineApi, PreviewsReuseTheLightTransmittanceWhileTheOptimisationRuns) {
+  Engine e;
+  e.loadBuiltinScene("shepp-logan", 32);
+  e.setViewportSize(64, 64);
+  ExtinctionSettings opt;
+  opt.levels = 1;
+  opt.maxIterationsPerLevel = opt.minIterationsPerLevel = 1;
+  e.setExtinctionSettings(opt);
+  RenderSettings full;
+  full.width = full.height = 64;
+  RenderSettings preview = full;
+  preview.preview = true;
+  RenderStats stats;
+  e.optimize();
+  e.render(full, &stats);
+  EXPECT_GT(stats.lightMilliseconds, 0.0);
+  e.continueOptimization(1);
+  e.render(preview, &stats);
+  EXPECT_EQ(stats.lightMilliseconds, 0.0) << "the preview reused T_L";
+  e.render(full, &stats);
+  EXPECT_GT(stats.lightMilliseconds, 0.0) << "the full frame recomputed it";
+  e.render(full, &stats);
+  EXPECT_EQ(stats.lightMilliseconds, 0.0) << "nothing changed since";
 }

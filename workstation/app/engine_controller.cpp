@@ -258,8 +258,16 @@ void EngineController::renderFrame(Engine& engine, bool preview) {
   info.preview = preview;
   RenderStats stats;
   QImage image;
+  // A full frame gives way to a newer camera or command (a preview is short).
+  const auto abandon = [this] {
+    std::lock_guard lock(mutex_);
+    return quit_ || cameraDirty_ || !tasks_.empty();
+  };
   try {
-    image = toQImage(engine.render(settings, &stats));
+    const Image rendered =
+        engine.render(settings, &stats, preview ? std::function<bool()>() : abandon);
+    if (rendered.width == 0) return;  // abandoned: the frame is still owed
+    image = toQImage(rendered);
   } catch (const std::exception& e) {
     const QString msg = QStringLiteral("render: ") + QString::fromUtf8(e.what());
     deliver([this, msg] { emit errorOccurred(msg); });
@@ -406,6 +414,13 @@ void EngineController::workerLoop() {
         running_ = false;
         const QString msg = QStringLiteral("optimisation: ") + QString::fromUtf8(e.what());
         deliver([this, msg] { emit errorOccurred(msg); });
+      }
+      {
+        // A camera that moved meanwhile (which may have abandoned the step) is answered first,
+        // with a preview if the user is dragging, not after a full frame of the old view.
+        std::lock_guard lock(mutex_);
+        if (cameraDirty_ || !tasks_.empty()) continue;
+        interacting = interacting_;
       }
       if (sinceFrame_.elapsed() > kFrameIntervalMs || converged_) renderFrame(engine, interacting);
       continue;

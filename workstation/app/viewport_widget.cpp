@@ -73,8 +73,12 @@ void ViewportWidget::onFrame(const QImage& image, const FrameInfo& info) {
   auto it = cameraSentAt_.find(info.cameraSerial);
   if (it != cameraSentAt_.end()) {
     // The first preview showing a drag: that is the latency the user feels.
-    if (info.preview) latencies_.push_back(double(now - it->second));
+    if (info.preview) {
+      latencies_.push_back(double(now - it->second));
+      previewRenderMs_.push_back(info.renderMs);
+    }
     while (latencies_.size() > 200) latencies_.pop_front();
+    while (previewRenderMs_.size() > 200) previewRenderMs_.pop_front();
     cameraSentAt_.erase(cameraSentAt_.begin(), std::next(it));
   }
   frameTimes_.push_back(now);
@@ -92,6 +96,9 @@ LatencyStats ViewportWidget::previewLatency() const {
   double sum = 0.0;
   for (double x : v) sum += x;
   s.meanMs = sum / double(v.size());
+  double render = 0.0;
+  for (double x : previewRenderMs_) render += x;
+  s.renderMeanMs = previewRenderMs_.empty() ? 0.0 : render / double(previewRenderMs_.size());
   std::sort(v.begin(), v.end());
   s.maxMs = v.back();
   s.p95Ms = v[std::min(v.size() - 1, size_t(std::ceil(0.95 * double(v.size()))) - 1)];

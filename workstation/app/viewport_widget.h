@@ -21,6 +21,7 @@ namespace visopt::ws {
 struct LatencyStats {
   int samples = 0;
   double lastMs = 0.0, meanMs = 0.0, maxMs = 0.0, p95Ms = 0.0;
+  double renderMeanMs = 0.0;  // of those previews' renders: the rest of the latency is waiting
 };
 
 class ViewportWidget : public QWidget {
@@ -71,6 +72,7 @@ class ViewportWidget : public QWidget {
   QTimer restTimer_;  // after wheel zooming: full resolution once the wheel stops
   std::map<uint64_t, qint64> cameraSentAt_;  // serial -> ms, for latency
   std::deque<double> latencies_;             // ms, most recent last
+  std::deque<double> previewRenderMs_;       // the matched previews' render times
   std::deque<qint64> frameTimes_;            // ms of recent frames
 };
 

@@ -142,8 +142,14 @@ class Engine {
   bool renderOptimized() const;
 
   // Renders the current scene. T_L is recomputed only when the light, the transfer function,
-  // the volume or the light grid size changed since the last render.
-  Image render(const RenderSettings& settings, RenderStats* stats = nullptr);
+  // the volume or the light grid size changed since the last render, or the optimisation
+  // changed mu: a preview (settings.preview) then reuses the last full frame's T_L and drawn
+  // extinction change, so that it answers a moving camera at once; the next full frame
+  // recomputes them.
+  // `abandon` (optional) is polled between bands of the image: when it returns true the render
+  // stops and returns an empty (0 x 0) image, for an interface whose camera moved meanwhile.
+  Image render(const RenderSettings& settings, RenderStats* stats = nullptr,
+               const std::function<bool()>& abandon = {});
 
   const MemoryLedger& ledger() const;
 

@@ -33,6 +33,9 @@ struct Engine::Impl {
   FrustumGrid lightFrustum;
   std::optional<Field3D> lightTransmittance;
   bool lightDirty = true;
+  // The optimisation changed mu since T_L and the extinction change were computed: a full frame
+  // recomputes both, a preview reuses them (render()).
+  bool muChanged = false;
   bool lightOptimized = true;  // T_L was computed for the optimised scene
   int lightGridSize = 0, lightGridDepth = -1;
 
@@ -270,15 +273,27 @@ const PointLight& Engine::light() const {
   return impl_->light;
 }
 
-Image Engine::render(const RenderSettings& settings, RenderStats* stats) {
+Image Engine::render(const RenderSettings& settings, RenderStats* stats,
+                     const std::function<bool()>& abandon) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
   impl_->ensureTable();
   const bool optimized = settings.method == RenderMethod::Optimized;
   if (optimized != impl_->lightOptimized) impl_->lightDirty = true;  // T_L of the other scene
   impl_->lightOptimized = optimized;
-  impl_->updateExtinctionChange(optimized);
+  // A preview while the optimisation runs (the user drags the camera) draws the latest mu with
+  // the T_L and extinction change of the last full frame: recomputing them took twice the
+  // preview's own render time.
+  const bool reuse = settings.preview && impl_->muChanged && !impl_->lightDirty &&
+                     impl_->lightTransmittance &&
+                     (!optimized || !impl_->renderOptimized || impl_->extinctionChange);
+  if (!reuse) {
+    if (impl_->muChanged) impl_->lightDirty = true;
+    impl_->muChanged = false;
+    impl_->updateExtinctionChange(optimized);
+  }
   double lightMs = impl_->ensureLight(settings);
-  Image image = renderImage(impl_->scene(optimized), settings, stats);
+  if (abandon && abandon()) return Image();
+  Image image = renderImage(impl_->scene(optimized), settings, stats, abandon);
   if (stats) stats->lightMilliseconds = lightMs;
   return image;
 }
@@ -497,9 +512,14 @@ std::vector<IterationStats> Engine::optimize(
     const std::function<bool(const IterationStats&)>& callback,
     const std::function<bool()>& abandon) {
   if (impl_->frozen) return {};
+  // Every iteration changes mu, also for a frame the callback renders.
+  const auto noted = [&](const IterationStats& st) {
+    impl_->muChanged = true;
+    return !callback || callback(st);
+  };
   auto stats = impl_->optimizer.runMultigrid(impl_->optimizationInputs(), impl_->extinctionSettings,
-                                             callback, abandon);
-  impl_->lightDirty = true;
+                                             noted, abandon);
+  impl_->muChanged = true;
   return stats;
 }
 
@@ -507,9 +527,13 @@ std::vector<IterationStats> Engine::continueOptimization(
     int iterations, const std::function<bool(const IterationStats&)>& callback,
     const std::function<bool()>& abandon) {
   if (impl_->frozen || iterations <= 0) return {};
+  const auto noted = [&](const IterationStats& st) {
+    impl_->muChanged = true;
+    return !callback || callback(st);
+  };
   auto stats = impl_->optimizer.iterate(impl_->optimizationInputs(), impl_->extinctionSettings,
-                                        iterations, callback, abandon);
-  impl_->lightDirty = true;
+                                        iterations, noted, abandon);
+  if (!stats.empty()) impl_->muChanged = true;
   return stats;
 }
 

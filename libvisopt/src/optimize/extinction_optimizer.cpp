@@ -493,6 +493,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
                     ghatNeeded ? &L.viewMax : nullptr, "view-importance-behind");
   else
     L.dView.reset();
+  if (abandonRequested()) return std::nullopt;  // nothing but scratch has changed yet
   if (lightGrids)
     light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
                      "light-derivative", precision_, ledger_, surfaces, ScreenWeights{},

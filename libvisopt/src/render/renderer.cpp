@@ -137,7 +137,8 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
                     scan);
 }
 
-Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats) {
+Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,
+                  const std::function<bool()>& abandon) {
   if (!scene.volume || !scene.transfer) throw Error(ErrorKind::Usage, "nothing to render");
   if (settings.width <= 0 || settings.height <= 0 || settings.width > 16384 ||
       settings.height > 16384)
@@ -207,8 +208,23 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   DeviceBuffer<glm::vec3> pixels(size_t(w) * size_t(h));
   p.pixels = pixels.data();
   const RayMarchKernel kernel(p);
-  const int64_t samples = exec::reduce("render", rayMarchItems(w, h), int64_t(0), kernel,
-                                       [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+  const auto sum = [] VISOPT_HD(int64_t a, int64_t b) { return a + b; };
+  const int64_t items = rayMarchItems(w, h);
+  int64_t samples = 0;
+  if (!abandon) {
+    samples = exec::reduce("render", items, int64_t(0), kernel, sum);
+  } else {
+    // Bands of whole ray tiles, so that a newer camera need not wait for the whole frame.
+    constexpr int64_t kBands = 8;
+    const int64_t tile = int64_t(kRayTile) * kRayTile;
+    const int64_t band = (items / tile + kBands - 1) / kBands * tile;
+    for (int64_t first = 0; first < items; first += band) {
+      if (abandon()) return Image();
+      samples += exec::reduce(
+          "render", std::min(band, items - first), int64_t(0),
+          [=] VISOPT_HD(int64_t item) { return kernel(first + item); }, sum);
+    }
+  }
 
   Image image(w, h);
   for (size_t i = 0; i < image.pixels.size(); ++i) image.pixels[i] = pixels[i] * settings.exposure;

@@ -1,6 +1,8 @@
 // The renderer's host side: builds kernel parameters from the scene and launches them.
 #pragma once
 
+#include <functional>
+
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -45,6 +47,9 @@ void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>
 void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
                                Field3D& out);
 
-Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats);
+// `abandon` (may be empty) is polled between bands of the image; when it returns true the render
+// stops and returns an empty (0 x 0) image.
+Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,
+                  const std::function<bool()>& abandon = {});
 
 }  // namespace visopt

@@ -51,9 +51,7 @@ VISOPT_HD VISOPT_INLINE bool nextToInterface(float c, float xm, float xp, float 
 // interior) grows until it is one voxel's distance beyond its neighbour's.
 template <class Ax>
 VISOPT_HD VISOPT_INLINE OneSided inflowOnly(OneSided d, const Ax& a) {
-  if (a.lo) d.dm = 0.f;
-  if (a.hi) d.dp = 0.f;
-  return d;
+  return {blendBits(a.loMask, 0.f, d.dm), blendBits(a.hiMask, 0.f, d.dp)};
 }
 
 template <class A, int Order>

@@ -356,6 +356,53 @@ TEST_P(LevelSetBand, ExtremesMatchTheDensePath) {
   }
 }
 
+// Bricks where ghat is 0 (with a voxel around) and phi is still phi0 are a fixed point of the
+// step and of redistancing against phi0 (narrow_band.h): the kernels skip them. A sphere opens
+// where ghat = 0.6 > lambda (x below the middle) and stays put elsewhere; with the fixed bricks
+// marked, every voxel of phi, every dt and every redistancing's pass count equal those of the
+// same band path without the marks, bit for bit, while the kernels run over fewer voxels.
+TEST_P(LevelSetBand, FixedBricksAreSkippedWithoutChangingAnything) {
+  const GridSpec g = box(glm::ivec3(64, 64, 64));
+  const glm::vec3 centre(31.6f, 32.2f, 31.9f);
+  const Field3D phi0 = makeField("phi0", g, GetParam(), sphere(centre, 18.f));
+  const Field3D ghat =
+      makeField("ghat", g, GetParam(), [](glm::vec3 x) { return x.x < 24.f ? 0.6f : 0.f; });
+  LevelSetSettings s;
+  s.lambda = 0.3f;
+  s.substeps = 6;
+  SurfaceRun marked{clone(phi0), {}}, plain{clone(phi0), {}};
+  NarrowBand markedBand, plainBand;
+  markFixedBricks(marked.phi, phi0, ghat, s, markedBand);
+  ASSERT_TRUE(markedBand.fixedFor(ghat));
+  EXPECT_GT(markedBand.fixedBricks(), 0);
+  int64_t work = 0, band = 0;
+  for (int n = 0; n < 12; ++n) {
+    const LevelSetStepStats a =
+        levelSetStep(marked.phi, phi0, ghat, nullptr, s, marked.scratch, &markedBand);
+    const LevelSetStepStats b =
+        levelSetStep(plain.phi, phi0, ghat, nullptr, s, plain.scratch, &plainBand);
+    ASSERT_EQ(a.timeStep, b.timeStep) << "step " << n;
+    EXPECT_EQ(a.bandVoxels, b.bandVoxels);
+    work = a.workVoxels;
+    band = a.bandVoxels;
+    const RedistanceStats ra = redistance(marked.phi, s, marked.scratch, &phi0, 3.f, &markedBand);
+    const RedistanceStats rb = redistance(plain.phi, s, plain.scratch, &phi0, 3.f, &plainBand);
+    ASSERT_EQ(ra.iterations, rb.iterations) << "redistancing " << n;
+    ASSERT_EQ(ra.meanSquaredChange, rb.meanSquaredChange);
+  }
+  size_t differ = 0, moved = 0;
+  for (size_t v = 0; v < phi0.size(); ++v) {
+    differ += marked.phi.get(v) != plain.phi.get(v);
+    moved += plain.phi.get(v) != phi0.get(v);
+  }
+  std::printf("fixed bricks: %lld of %lld band voxels skipped, %zu voxels moved, %zu differ\n",
+              static_cast<long long>(band - work), static_cast<long long>(band), moved, differ);
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(moved, 1000u) << "the sphere opened where ghat > lambda";
+  EXPECT_LT(work, band) << "the fixed bricks were skipped";
+  EXPECT_GT(work, 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(Precisions, LevelSetBand,
                          ::testing::Values(Precision::FP32, Precision::FP16),
                          [](const auto& param) {

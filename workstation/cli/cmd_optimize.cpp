@@ -44,6 +44,7 @@ nlohmann::json statsJson(const IterationStats& s) {
           {"redistance_calls", s.redistanceCalls},
           {"redistance_passes", s.redistancePasses},
           {"band_voxels", s.bandVoxels},
+          {"band_work_voxels", s.bandWorkVoxels},
           {"redistance_residual", s.redistanceResidual},
           {"level_set_time_step", s.levelSetTimeStep},
           {"level_set_substeps", s.levelSetSubsteps},

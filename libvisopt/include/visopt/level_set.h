@@ -64,7 +64,8 @@ struct LevelSetStepStats {
   // fast a kink of the inside can come up towards zero (ChangeSums::insideRiseMax).
   double insideRise = 0.0;
   double meanChange = 0.0;    // mean |delta phi| per substep
-  int64_t bandVoxels = 0;     // voxels the band path ran over (0: the whole grid)
+  int64_t bandVoxels = 0;     // voxels of the band (0: the whole grid)
+  int64_t workVoxels = 0;     // of which the step ran over (the band less its fixed bricks)
   bool hasInterface = false;  // phi has a surface after the step (a sign change somewhere)
 };
 
@@ -72,7 +73,8 @@ struct RedistanceStats {
   int iterations = 0;
   double meanSquaredChange = 0.0;  // of the last iteration, in voxel units squared
   bool converged = false;          // stopped early below the tolerance
-  int64_t bandVoxels = 0;          // voxels the band path ran over (0: the whole grid)
+  int64_t bandVoxels = 0;          // voxels of the band (0: the whole grid)
+  int64_t workVoxels = 0;          // of which redistancing ran over (less the fixed bricks)
 };
 
 }  // namespace visopt

@@ -68,6 +68,7 @@ struct IterationStats {
   int redistanceCalls = 0;          // redistancing calls (all surfaces)
   int redistancePasses = 0;         // redistancing iterations of all calls
   int64_t bandVoxels = 0;           // voxels of the surfaces' narrow bands at the end (0: dense)
+  int64_t bandWorkVoxels = 0;       // of which the level-set kernels update (not fixed bricks)
   double redistanceResidual = 0.0;  // mean squared change of the last iteration (voxels^2)
   double levelSetTimeStep = 0.0;
   int levelSetSubsteps = 0;           // substeps of Eq. 23 this iteration

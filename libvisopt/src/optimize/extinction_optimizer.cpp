@@ -656,6 +656,11 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
           ghat.store(v, fminf(fmaxf(g, 0.f), 1.f));
         });
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
+  // The bricks of each band that this ghat leaves as they are (narrow_band.h), once per ghat.
+  for (size_t si = 0; si < L.phi.size(); ++si)
+    if (!L.ghatFixed || !L.bands[si].fixedFor(*L.ghat))
+      markFixedBricks(L.phi[si], L.finest ? *in.surfaceBases[si] : L.phi0[si], *L.ghat, in.levelSet,
+                      L.bands[si]);
   st.sdfStepMs = msSince(t0);
   // The level-set substeps run in chunks; redistancing (Eq. 18) runs once the steps since the
   // last one may have moved phi by half a voxel somewhere, so |grad phi| stays near 1 while a
@@ -730,7 +735,10 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     const double fits = rate > 0.0 ? 0.5 * h / rate : 64.0;
     chunk = int(std::clamp(std::floor(fits), double(std::max(in.levelSet.substeps, 1)), 64.0));
   }
-  for (const NarrowBand& b : L.bands) st.bandVoxels += b.band().voxels;
+  for (const NarrowBand& b : L.bands) {
+    st.bandVoxels += b.band().voxels;
+    st.bandWorkVoxels += b.work().voxels;
+  }
   st.levelSetTimeStep = ls.timeStep;
   st.levelSetSubsteps = substepsDone;
   st.levelSetMotionVoxels = L.lastMotion / h;

@@ -209,9 +209,16 @@ ChangeSums substep(const Field3D& phi, const Field3D& phi0, const Field3D& ghat,
   });
 }
 
+// What a band pass's mean change divides by beyond the voxels it ran over: the band's voxels
+// (0: those it ran over) and, for the mean near the surface, the near voxels it skipped.
+struct BandMean {
+  int64_t voxels = 0;
+  double idleNear = 0.0;
+};
+
 template <class A, int Order>
 double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, const Field3D* base,
-                          float stopBand, const Band* band) {
+                          float stopBand, const Band* band, const BandMean& mean) {
   const GridSpec& g = in.grid();
   RedistanceKernel<A, Order> k;
   k.in = accessOf(in, Tag<A>{});
@@ -230,19 +237,22 @@ double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, cons
   if (stopBand > 0.f) k.nearBand = stopBand * k.dxMin;
   const ChangeSums c = band ? launchBand<ChangeSums>("level set: redistance (band)", k, *band)
                             : launchStencil<ChangeSums>("level set: redistance", k, g.dims);
-  if (stopBand > 0.f)
-    return c.nearCount > 0.0 ? c.nearSumSquared / (double(k.dxMin) * k.dxMin) / c.nearCount : 0.0;
-  const double voxels = band ? double(std::max<int64_t>(band->voxels, 1)) : double(in.size());
+  if (stopBand > 0.f) {
+    const double near = c.nearCount + mean.idleNear;
+    return near > 0.0 ? c.nearSumSquared / (double(k.dxMin) * k.dxMin) / near : 0.0;
+  }
+  const double voxels =
+      band ? double(std::max<int64_t>(std::max(band->voxels, mean.voxels), 1)) : double(in.size());
   return c.sumSquared / (double(k.dxMin) * k.dxMin) / voxels;
 }
 
 double redistancePass(const Field3D& in, Field3D& out, bool initialise, int order,
                       const Field3D* base = nullptr, float stopBand = 0.f,
-                      const Band* band = nullptr) {
+                      const Band* band = nullptr, const BandMean& mean = {}) {
   auto run = [&](auto tag) {
     using A = typename decltype(tag)::type;
-    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base, stopBand, band)
-                      : redistancePassWith<A, 2>(in, out, initialise, base, stopBand, band);
+    return order == 1 ? redistancePassWith<A, 1>(in, out, initialise, base, stopBand, band, mean)
+                      : redistancePassWith<A, 2>(in, out, initialise, base, stopBand, band, mean);
   };
   return base ? dispatch({&in, &out, base}, run) : dispatch({&in, &out}, run);
 }
@@ -319,27 +329,35 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   NarrowBand own;
   NarrowBand& narrow = band ? *band : own;
   const bool banded = useBand(s) && s.substeps > 0;
+  // The band's fixed bricks (narrow_band.h: markFixed) hold for the ghat and phi0 they were
+  // marked with only; the kernels then skip them.
+  const Band* work = nullptr;
   if (banded) {
     // Without the return term (lambda = 0) phi0 and the region the surface swept need no band.
     narrow.ensure(phi, s.lambda > 0.f ? &phi0 : nullptr, s.band);
+    const bool skipFixed = narrow.fixedFor(ghat) && narrow.base() == &phi0;
+    work = skipFixed ? &narrow.work() : &narrow.band();
     stats.bandVoxels = narrow.band().voxels;
-    copySpans(phi, scratch, narrow.halo());
-    stats.timeStep = timeStepFrom(stepBoundsWithin(ghat, narrow.band()), ghat.grid(), s);
+    stats.workVoxels = work->voxels;
+    copySpans(phi, scratch, skipFixed ? narrow.workHalo() : narrow.halo());
+    StepBounds bounds = stepBoundsWithin(ghat, *work);
+    // Fixed bricks have ghat = 0 and grad ghat = 0: the bounds over the whole band.
+    if (work->voxels < narrow.band().voxels) bounds = bounds + StepBounds{0.f, 0.f, 0.f};
+    stats.timeStep = timeStepFrom(bounds, ghat.grid(), s);
   } else {
     stats.timeStep = levelSetTimeStep(ghat, s);
   }
   Field3D* from = &phi;
   Field3D* to = &scratch;
   for (int n = 0; n < s.substeps; ++n) {
-    const ChangeSums c = substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to,
-                                 banded ? &narrow.band() : nullptr);
+    const ChangeSums c = substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to, work);
     stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
     stats.insideRise = std::max(stats.insideRise, double(c.insideRiseMax));
     stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
     stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
     std::swap(from, to);
   }
-  if (from != &phi) copyResult(*from, phi, banded ? &narrow.band() : nullptr);
+  if (from != &phi) copyResult(*from, phi, work);
   if (!banded) {
     stats.hasInterface = hasInterface(phi);
     return stats;
@@ -348,6 +366,15 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   stats.hasInterface = interfaceWithin(phi, narrow.halo());
   narrow.refresh(phi);
   return stats;
+}
+
+void markFixedBricks(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
+                     const LevelSetSettings& s, NarrowBand& band) {
+  if (!useBand(s) || !(s.lambda > 0.f)) return;  // without the return term no phi0 in the band
+  requireSameGrid(phi, phi0, "the base SDF phi0");
+  requireSameGrid(phi, ghat, "ghat");
+  band.ensure(phi, &phi0, s.band);
+  band.markFixed(phi, ghat);
 }
 
 // ---- redistancing (Eq. 18) --------------------------------------------------------------------
@@ -381,17 +408,26 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
     stats.converged = true;
     return stats;
   }
+  // Fixed bricks equal the base: redistancing against it holds them (narrow_band.h). The mean
+  // change still counts them, as 0, so that the early stop does not depend on the skip.
+  const Band* work = nullptr;
+  BandMean mean;
   if (banded) {
+    const bool skipFixed = base && narrow.base() == base && narrow.fixedBricks() > 0;
+    work = skipFixed ? &narrow.work() : &narrow.band();
     stats.bandVoxels = narrow.band().voxels;
-    copySpans(phi, scratch, narrow.halo());
+    stats.workVoxels = work->voxels;
+    mean.voxels = narrow.band().voxels;
+    if (skipFixed && stopBand > 0.f)
+      mean.idleNear = double(narrow.idleNearVoxels(phi, stopBand * phi.grid().minSpacing()));
+    copySpans(phi, scratch, skipFixed ? narrow.workHalo() : narrow.halo());
   }
   Field3D* from = &phi;
   Field3D* to = &scratch;
   for (int n = 0; n < s.redistanceIterations; ++n) {
     // The first pass also sets the interface band to its subcell distance (kept afterwards).
-    stats.meanSquaredChange =
-        redistancePass(*from, *to, n == 0, s.spatialOrder, base, std::max(stopBand, 0.f),
-                       banded ? &narrow.band() : nullptr);
+    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder, base,
+                                             std::max(stopBand, 0.f), work, mean);
     stats.iterations = n + 1;
     std::swap(from, to);
     if (stats.meanSquaredChange < double(s.redistanceTolerance)) {
@@ -399,7 +435,7 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
       break;
     }
   }
-  if (from != &phi) copyResult(*from, phi, banded ? &narrow.band() : nullptr);
+  if (from != &phi) copyResult(*from, phi, work);
   if (banded) narrow.refresh(phi);
   return stats;
 }

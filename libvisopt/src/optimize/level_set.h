@@ -58,6 +58,13 @@ double levelSetSubstep(const Field3D& phi, const Field3D& phi0, const Field3D& g
                        Field3D& out);
 double redistanceIteration(const Field3D& in, Field3D& out, int spatialOrder = 2);
 
+// On the band path, builds `band` for phi if needed and marks its bricks that the step with
+// this ghat and redistancing against phi0 leave unchanged (NarrowBand::markFixed), which the
+// next levelSetStep and redistance calls with the same ghat and phi0 skip. Call whenever ghat's
+// values change. Nothing happens on the dense path.
+void markFixedBricks(Field3D& phi, const Field3D& phi0, const Field3D& ghat,
+                     const LevelSetSettings& s, NarrowBand& band);
+
 // The default Gaussian pre-smoothing of sdfFromIsovalue, sigma in voxels (see there).
 inline constexpr float kIsoPresmoothSigma = 0.85f;
 

@@ -14,6 +14,7 @@ namespace visopt {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr uint8_t kActiveBrick = 1, kFixedBrick = 3;  // flags_ values (0: inactive)
 
 size_t brickIndex(glm::ivec3 b, glm::ivec3 nb) {
   return size_t(b.x) + size_t(nb.x) * (size_t(b.y) + size_t(nb.y) * size_t(b.z));
@@ -76,6 +77,25 @@ void boundFromFace(const FieldView& phi, glm::ivec3 b, glm::ivec3 from, glm::ive
         const float value = phi.load(v);
         if (std::fabs(value) > bound) phi.store(v, value < 0.f ? -bound : bound);
       }
+}
+
+// True when ghat is 0 on brick b and one voxel around it (its central differences read that far)
+// and phi equals phi0 on it: a fixed point of the step and of redistancing (narrow_band.h).
+bool brickIsFixed(const FieldView& phi, const FieldView& phi0, const FieldView& ghat, glm::ivec3 b,
+                  glm::ivec3 d) {
+  const glm::ivec3 lo = b * kBrick, hi = glm::min(lo + kBrick, d);
+  const glm::ivec3 glo = glm::max(lo - 1, glm::ivec3(0)), ghi = glm::min(hi + 1, d);
+  for (int k = glo.z; k < ghi.z; ++k)
+    for (int j = glo.y; j < ghi.y; ++j)
+      for (int i = glo.x; i < ghi.x; ++i)
+        if (ghat.load(ghat.index(i, j, k)) != 0.f) return false;
+  for (int k = lo.z; k < hi.z; ++k)
+    for (int j = lo.y; j < hi.y; ++j)
+      for (int i = lo.x; i < hi.x; ++i) {
+        const size_t v = phi.index(i, j, k);
+        if (!(phi.load(v) == phi0.load(v))) return false;
+      }
+  return true;
 }
 
 void appendSpans(const std::vector<uint8_t>& flags, glm::ivec3 nb, glm::ivec3 d, SpanList& out) {
@@ -192,17 +212,77 @@ void NarrowBand::refresh(Field3D& phi) {
   rebuildSpans();
 }
 
+namespace {
+// The bricks flagged in `from` and their 26 neighbours.
+std::vector<uint8_t> dilated(const std::vector<uint8_t>& from, glm::ivec3 nb) {
+  std::vector<uint8_t> near(from.size(), 0);
+  for (size_t a = 0; a < from.size(); ++a) {
+    if (!from[a]) continue;
+    const glm::ivec3 b = brickCoords(a, nb);
+    for (int z = std::max(b.z - 1, 0); z <= std::min(b.z + 1, nb.z - 1); ++z)
+      for (int y = std::max(b.y - 1, 0); y <= std::min(b.y + 1, nb.y - 1); ++y)
+        for (int x = std::max(b.x - 1, 0); x <= std::min(b.x + 1, nb.x - 1); ++x)
+          near[brickIndex({x, y, z}, nb)] = 1;
+  }
+  return near;
+}
+}  // namespace
+
 void NarrowBand::rebuildSpans() {
-  std::vector<uint8_t> near(flags_.size(), 0);
+  appendSpans(flags_, nb_, dims_, band_);
+  appendSpans(dilated(flags_, nb_), nb_, dims_, halo_);
+  fixedBricks_ = 0;
+  idle_.clear();
+  idleNearBand_ = -1.f;
+  for (const int32_t a : active_) fixedBricks_ += flags_[size_t(a)] == kFixedBrick;
+  if (fixedBricks_ == 0) return;
+  // Work: the active bricks that can change, and a fixed one between two of them along x.
+  std::vector<uint8_t> work(flags_.size(), 0);
+  for (const int32_t a : active_) work[size_t(a)] = flags_[size_t(a)] == kActiveBrick;
   for (const int32_t a : active_) {
     const glm::ivec3 b = brickCoords(size_t(a), nb_);
-    for (int z = std::max(b.z - 1, 0); z <= std::min(b.z + 1, nb_.z - 1); ++z)
-      for (int y = std::max(b.y - 1, 0); y <= std::min(b.y + 1, nb_.y - 1); ++y)
-        for (int x = std::max(b.x - 1, 0); x <= std::min(b.x + 1, nb_.x - 1); ++x)
-          near[brickIndex({x, y, z}, nb_)] = 1;
+    if (flags_[size_t(a)] == kFixedBrick && b.x > 0 && b.x + 1 < nb_.x &&
+        flags_[size_t(a) - 1] == kActiveBrick && flags_[size_t(a) + 1] == kActiveBrick)
+      work[size_t(a)] = 1;
   }
-  appendSpans(flags_, nb_, dims_, band_);
-  appendSpans(near, nb_, dims_, halo_);
+  for (const int32_t a : active_)
+    if (!work[size_t(a)]) idle_.push_back(a);
+  appendSpans(work, nb_, dims_, work_);
+  appendSpans(dilated(work, nb_), nb_, dims_, workHalo_);
+}
+
+void NarrowBand::markFixed(const Field3D& phi, const Field3D& ghat) {
+  fixedGhat_ = ghat.raw();
+  if (flags_.empty()) return;
+  for (const int32_t a : active_) flags_[size_t(a)] = kActiveBrick;
+  if (phi0_ && phi.grid().dims == dims_ && ghat.grid().dims == dims_ &&
+      phi0_->grid().dims == dims_) {
+    const FieldView p(phi), base(*phi0_), g(ghat);
+    const glm::ivec3 d = dims_, nb = nb_;
+    std::vector<uint8_t> fixed(active_.size(), 0);
+    tbb::parallel_for(size_t(0), active_.size(), [&](size_t a) {
+      fixed[a] = brickIsFixed(p, base, g, brickCoords(size_t(active_[a]), nb), d);
+    });
+    for (size_t a = 0; a < active_.size(); ++a)
+      if (fixed[a]) flags_[size_t(active_[a])] = kFixedBrick;
+  }
+  rebuildSpans();
+}
+
+int64_t NarrowBand::idleNearVoxels(const Field3D& phi, float nearBand) {
+  if (idle_.empty()) return 0;
+  if (nearBand == idleNearBand_) return idleNear_;
+  const FieldView p(phi);
+  int64_t count = 0;
+  for (const int32_t a : idle_) {
+    const glm::ivec3 lo = brickCoords(size_t(a), nb_) * kBrick, hi = glm::min(lo + kBrick, dims_);
+    for (int k = lo.z; k < hi.z; ++k)
+      for (int j = lo.y; j < hi.y; ++j)
+        for (int i = lo.x; i < hi.x; ++i) count += std::fabs(p.load(p.index(i, j, k))) <= nearBand;
+  }
+  idleNearBand_ = nearBand;
+  idleNear_ = count;
+  return count;
 }
 
 }  // namespace visopt

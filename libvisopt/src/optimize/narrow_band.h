@@ -19,6 +19,16 @@
 // oscillating about a brick's edge does not switch it on and off) and no active neighbour's face
 // claims it.
 //
+// Bricks that cannot change (markFixed): where ghat is 0 on a brick and one voxel around it and
+// phi equals phi0 on it, Eq. 23 leaves every voxel exactly as it is (the drive term is
+// max(0, 0 kappa |grad phi| + 0 . grad phi) = 0, the return term lambda (phi0 - phi) = 0), and so
+// does redistancing against phi0 (it holds voxels within kRedistanceKeepsBaseWithin of phi0).
+// The back of a CT's skin, which hides nothing from the view, is such a region. Nothing but the
+// kernels and the claims write phi, and neither writes an active brick's values outside the work
+// spans, so a fixed brick stays one until ghat changes, when the caller marks the band anew.
+// The kernels then run over the work spans: runs of the other active bricks along x (with a
+// fixed brick between two of them, so that rows stay long enough to vectorise).
+//
 // Host data: the band path runs on the CPU backend.
 #pragma once
 
@@ -27,9 +37,9 @@
 
 #include <glm/glm.hpp>
 
-namespace visopt {
+#include "visopt/field.h"
 
-class Field3D;
+namespace visopt {
 
 inline constexpr int kBrick = 8;
 
@@ -61,6 +71,23 @@ class NarrowBand {
   void refresh(Field3D& phi);
   void clear() { *this = NarrowBand(); }
 
+  // Marks the active bricks that are a fixed point of the step with this ghat (on phi's grid)
+  // and of redistancing against the band's base (needs a band built with phi0; nothing is
+  // marked otherwise). Call again whenever ghat changes: the marks hold for this ghat's values.
+  void markFixed(const Field3D& phi, const Field3D& ghat);
+  // True when the marks were made for this ghat field (its storage).
+  bool fixedFor(const Field3D& ghat) const {
+    return fixedGhat_ != nullptr && ghat.raw() == fixedGhat_;
+  }
+  // The voxels the kernels must update: the band without the fixed bricks (the band itself
+  // before any mark), and as far as their stencils reach.
+  const SpanList& work() const { return fixedBricks_ > 0 ? work_ : band_; }
+  const SpanList& workHalo() const { return fixedBricks_ > 0 ? workHalo_ : halo_; }
+  int64_t fixedBricks() const { return fixedBricks_; }
+  // Voxels of the band outside the work spans with |phi| <= nearBand (world units): what a
+  // mean over the band counts there (their change is 0). Cached until the spans change.
+  int64_t idleNearVoxels(const Field3D& phi, float nearBand);
+
   bool empty() const { return active_.empty(); }
   const Field3D* base() const { return phi0_; }
   // The active bricks as spans, and their halo (the active bricks and their 26 neighbours,
@@ -81,9 +108,14 @@ class NarrowBand {
   const Field3D* phi0_ = nullptr;
   float halfWidthVoxels_ = 0.f;
   float h_ = 1.f;                // the grid's smallest spacing
-  std::vector<uint8_t> flags_;   // per brick (x fastest): 1 = active
+  std::vector<uint8_t> flags_;   // per brick (x fastest): 1 = active, 3 = active and fixed
   std::vector<int32_t> active_;  // the active bricks' indices, ascending
-  SpanList band_, halo_;
+  SpanList band_, halo_, work_, workHalo_;
+  const void* fixedGhat_ = nullptr;
+  int64_t fixedBricks_ = 0;
+  std::vector<int32_t> idle_;  // active bricks outside the work spans
+  float idleNearBand_ = -1.f;
+  int64_t idleNear_ = 0;
   int64_t lastActivated_ = 0, lastReleased_ = 0;
 };
 

@@ -340,9 +340,10 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
     stats.bandVoxels = narrow.band().voxels;
     stats.workVoxels = work->voxels;
     copySpans(phi, scratch, skipFixed ? narrow.workHalo() : narrow.halo());
-    StepBounds bounds = stepBoundsWithin(ghat, *work);
-    // Fixed bricks have ghat = 0 and grad ghat = 0: the bounds over the whole band.
-    if (work->voxels < narrow.band().voxels) bounds = bounds + StepBounds{0.f, 0.f, 0.f};
+    // Over the whole band (fixed bricks have ghat = 0 and grad ghat = 0); with the marks, from
+    // bounds kept per brick while ghat stays the same.
+    const StepBounds bounds =
+        narrow.fixedFor(ghat) ? narrow.workBounds(ghat) : stepBoundsWithin(ghat, narrow.band());
     stats.timeStep = timeStepFrom(bounds, ghat.grid(), s);
   } else {
     stats.timeStep = levelSetTimeStep(ghat, s);

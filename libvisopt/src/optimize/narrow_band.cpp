@@ -233,6 +233,7 @@ void NarrowBand::rebuildSpans() {
   appendSpans(dilated(flags_, nb_), nb_, dims_, halo_);
   fixedBricks_ = 0;
   idle_.clear();
+  workBricks_.clear();
   idleNearBand_ = -1.f;
   for (const int32_t a : active_) fixedBricks_ += flags_[size_t(a)] == kFixedBrick;
   if (fixedBricks_ == 0) return;
@@ -245,14 +246,16 @@ void NarrowBand::rebuildSpans() {
         flags_[size_t(a) - 1] == kActiveBrick && flags_[size_t(a) + 1] == kActiveBrick)
       work[size_t(a)] = 1;
   }
-  for (const int32_t a : active_)
-    if (!work[size_t(a)]) idle_.push_back(a);
+  workBricks_.clear();
+  for (const int32_t a : active_) (work[size_t(a)] ? workBricks_ : idle_).push_back(a);
   appendSpans(work, nb_, dims_, work_);
   appendSpans(dilated(work, nb_), nb_, dims_, workHalo_);
 }
 
 void NarrowBand::markFixed(const Field3D& phi, const Field3D& ghat) {
   fixedGhat_ = ghat.raw();
+  boundsKnown_.assign(flags_.size(), 0);
+  brickBounds_.resize(flags_.size());
   if (flags_.empty()) return;
   for (const int32_t a : active_) flags_[size_t(a)] = kActiveBrick;
   if (phi0_ && phi.grid().dims == dims_ && ghat.grid().dims == dims_ &&
@@ -267,6 +270,34 @@ void NarrowBand::markFixed(const Field3D& phi, const Field3D& ghat) {
       if (fixed[a]) flags_[size_t(active_[a])] = kFixedBrick;
   }
   rebuildSpans();
+}
+
+StepBounds NarrowBand::workBounds(const Field3D& ghat) {
+  const std::vector<int32_t>& bricks = fixedBricks_ > 0 ? workBricks_ : active_;
+  StepBounds total;
+  if (!fixedFor(ghat) || boundsKnown_.size() != flags_.size()) return total;
+  std::vector<int32_t> missing;
+  for (const int32_t b : bricks)
+    if (!boundsKnown_[size_t(b)]) missing.push_back(b);
+  const GridSpec& g = ghat.grid();
+  const StepBoundsKernel k{FieldView(ghat), g.dims, g.spacing};
+  const glm::ivec3 d = dims_, nb = nb_;
+  StepBounds* out = brickBounds_.data();
+  tbb::parallel_for(size_t(0), missing.size(), [&](size_t m) {
+    const glm::ivec3 lo = brickCoords(size_t(missing[m]), nb) * kBrick,
+                     hi = glm::min(lo + kBrick, d);
+    StepBounds b;
+    for (int z = lo.z; z < hi.z; ++z)
+      for (int y = lo.y; y < hi.y; ++y) {
+        const int64_t row = int64_t(d.x) * (int64_t(y) + int64_t(d.y) * z);
+        for (int x = lo.x; x < hi.x; ++x) b = b + k(row + x);
+      }
+    out[missing[m]] = b;
+  });
+  for (const int32_t b : missing) boundsKnown_[size_t(b)] = 1;
+  for (const int32_t b : bricks) total = total + brickBounds_[size_t(b)];
+  if (fixedBricks_ > 0 && !idle_.empty()) total = total + StepBounds{0.f, 0.f, 0.f};
+  return total;
 }
 
 int64_t NarrowBand::idleNearVoxels(const Field3D& phi, float nearBand) {

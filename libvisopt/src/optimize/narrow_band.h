@@ -37,6 +37,7 @@
 
 #include <glm/glm.hpp>
 
+#include "kernels/level_set_step.h"
 #include "visopt/field.h"
 
 namespace visopt {
@@ -84,6 +85,10 @@ class NarrowBand {
   const SpanList& work() const { return fixedBricks_ > 0 ? work_ : band_; }
   const SpanList& workHalo() const { return fixedBricks_ > 0 ? workHalo_ : halo_; }
   int64_t fixedBricks() const { return fixedBricks_; }
+  // The bounds of the stable time step (max |grad ghat|, max and min ghat) over the work spans
+  // and, as 0, over the fixed bricks outside them: the same as over the whole band. Needs
+  // fixedFor(ghat); each brick's bounds are computed once per mark and kept.
+  StepBounds workBounds(const Field3D& ghat);
   // Voxels of the band outside the work spans with |phi| <= nearBand (world units): what a
   // mean over the band counts there (their change is 0). Cached until the spans change.
   int64_t idleNearVoxels(const Field3D& phi, float nearBand);
@@ -113,7 +118,10 @@ class NarrowBand {
   SpanList band_, halo_, work_, workHalo_;
   const void* fixedGhat_ = nullptr;
   int64_t fixedBricks_ = 0;
-  std::vector<int32_t> idle_;  // active bricks outside the work spans
+  std::vector<int32_t> idle_;            // active bricks outside the work spans
+  std::vector<int32_t> workBricks_;      // the bricks of the work spans
+  std::vector<StepBounds> brickBounds_;  // per brick, valid where boundsKnown_
+  std::vector<uint8_t> boundsKnown_;
   float idleNearBand_ = -1.f;
   int64_t idleNear_ = 0;
   int64_t lastActivated_ = 0, lastReleased_ = 0;

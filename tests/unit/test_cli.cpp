@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -181,4 +182,84 @@ TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
                 " --context mesh:" + tmp("nope.obj"))
                 .code,
             2);
+}
+
+// Every number a user types is checked before anything runs (issue 13): NaN and infinite values,
+// cameras and lights on the volume's centre or 1e30 radii away, ray-march steps that would run
+// for hours, level-set and optimiser settings the kernels would turn into NaN fields. Each is a
+// usage error (exit 1) whose one line names the option or the setting, and no image is written.
+// Before, a NaN camera or a 1e30 distance ended in a segmentation fault, --step 1e-6 ran for
+// hours and --lambda nan was accepted.
+TEST(Cli, EveryNumberAUserTypesIsChecked) {
+  const std::string out = tmp("checked.png");
+  const std::string render = "render --scene builtin:shepp-logan --resolution 16 --size 16x16 ";
+  const std::string optimize =
+      "optimize --scene builtin:shepp-logan --resolution 16 --size 16x16 --levels 1 "
+      "--iterations 1 ";
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {render + "--camera nan,0,2", "--camera: 'nan,0,2' is not a list of finite numbers"},
+      {render + "--camera 0,inf,2", "is not a list of finite numbers"},
+      {render + "--camera 0,0,1e30", "--camera: the distance must be"},
+      {render + "--camera 0,0,1e-30", "--camera: the distance must be"},
+      {render + "--camera 0,0,0", "--camera: the distance must be"},
+      {render + "--step 1e-6", "the ray-march step must be 0.05..16"},
+      {render + "--step inf", "the ray-march step must be"},
+      {render + "--step nan", "the ray-march step must be"},
+      {optimize + "--camera nan,0,2", "is not a list of finite numbers"},
+      {optimize + "--light 0,0,1e30", "--light: the distance must be"},
+      {optimize + "--view-from 0,0,1e30", "--view-from: the distance must be"},
+      {optimize + "--lambda nan", "lambda must be finite"},
+      {optimize + "--lambda -1", "lambda must be finite, >= 0"},
+      {optimize + "--level-set-reach inf", "the level-set reach must be"},
+      {optimize + "--level-set-band nan", "the narrow band must be"},
+      {optimize + "--redist-iterations -5", "redistancing iterations must be"},
+      {optimize + "--tolerance nan", "the energy tolerance must be finite"},
+      {optimize + "--lens 8,8,4,1e30", "the lens needs"},
+  };
+  for (const auto& c : cases) {
+    std::filesystem::remove(out);
+    const Result r = run(c.args + " --out " + out);
+    EXPECT_EQ(r.code, 1) << c.args << "\n" << r.err;
+    EXPECT_NE(lastLine(r.err).find(c.says), std::string::npos) << c.args << ": " << lastLine(r.err);
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
+  }
+  // Inside the volume, at an elevation of 90 degrees and at the finest step: fine.
+  for (const std::string args :
+       {"--camera 0,0,0.5", "--camera 30,90,2", "--step 0.05", "--camera 1e6,0,2"}) {
+    const Result r = run(render + args + " --out " + out);
+    EXPECT_EQ(r.code, 0) << args << "\n" << r.err;
+  }
+}
+
+// Paths that name a device, a FIFO or a folder are refused, for input (a transfer function
+// /dev/zero was read without end, a FIFO blocked) and for output (the written file was renamed
+// over the target: as root, --out /dev/full replaced the device with a PNG). The output check
+// comes before the work: optimize refuses a FIFO as --out before it optimises.
+TEST(Cli, DevicesPipesAndFoldersAreRefused) {
+  const std::string fifo = tmp("a-fifo");
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string render = "render --scene builtin:shepp-logan --resolution 16 --size 16x16 ";
+  Result r = run(render + "--tf /dev/zero --out " + tmp("dev.png"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(lastLine(r.err).find("/dev/zero: is a device, pipe or socket"), std::string::npos)
+      << r.err;
+  r = run(render + "--tf " + fifo + " --out " + tmp("dev.png"));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(lastLine(r.err).find(fifo + ": is a device, pipe or socket"), std::string::npos)
+      << r.err;
+  r = run(render + "--out " + fifo);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(lastLine(r.err).find("visopt writes only regular files"), std::string::npos) << r.err;
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo)) << "the FIFO is still a FIFO";
+  r = run(render + "--out " + tmp(""));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(lastLine(r.err).find("is a folder"), std::string::npos) << r.err;
+  r = run("optimize --scene builtin:shepp-logan --resolution 16 --size 16x16 --out " + fifo);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_EQ(r.err.find("level 0"), std::string::npos) << "refused before optimising";
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  std::filesystem::remove(fifo);
 }

@@ -1,7 +1,13 @@
 // Engine facade additions the workstation uses: removing a context surface, recolouring one,
 // reading back the render-optimised flag and the viewport size, a render that gives way to a
 // newer camera, and previews that reuse the light transmittance while the optimisation runs.
+#include <sys/resource.h>
+
 #include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -188,4 +194,106 @@ TEST(EngineApi, PreviewsReuseTheLightTransmittanceWhileTheOptimisationRuns) {
   EXPECT_GT(stats.lightMilliseconds, 0.0) << "the full frame recomputed it";
   e.render(full, &stats);
   EXPECT_EQ(stats.lightMilliseconds, 0.0) << "nothing changed since";
+}
+
+namespace {
+
+// True when `f` throws Error(Usage) whose message contains `says`.
+bool refused(const std::function<void()>& f, const std::string& says) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.kind() == ErrorKind::Usage && std::string(e.what()).find(says) != std::string::npos;
+  }
+  return false;
+}
+
+}  // namespace
+
+// A camera, light, step or level-set setting the kernels cannot use is refused where it is set
+// (issue 13: a NaN camera, a 1e30 or 1e-30 distance segfaulted the renderer, a step of 1e-6 ran
+// for hours), and the engine keeps what it had.
+TEST(EngineApi, CamerasLightsStepsAndLevelSetSettingsOutOfRangeAreRefused) {
+  Engine e;
+  emptyScene(e);
+  const Camera good = e.camera();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto withEye = [&](glm::vec3 eye) {
+    Camera c = good;
+    c.eye = eye;
+    return c;
+  };
+  EXPECT_TRUE(refused([&] { e.setCamera(withEye({nan, 0.f, 0.f})); }, "finite"));
+  EXPECT_TRUE(refused([&] { e.setCamera(withEye(good.target)); }, "bounding radii"));
+  EXPECT_TRUE(refused([&] { e.setCamera(withEye({0.f, 0.f, 1e30f})); }, "bounding radii"));
+  Camera narrow = good;
+  narrow.fovYDegrees = 0.f;
+  EXPECT_TRUE(refused([&] { e.setCamera(narrow); }, "field of view"));
+  Camera upAlong = good;
+  upAlong.up = good.target - good.eye;
+  EXPECT_TRUE(refused([&] { e.setCamera(upAlong); }, "up vector"));
+  EXPECT_TRUE(refused([&] { e.orbitCamera(nan, 0.f, 2.f); }, "finite"));
+  EXPECT_TRUE(refused([&] { e.orbitCamera(0.f, 0.f, 1e30f); }, "distance"));
+  EXPECT_TRUE(refused([&] { e.orbitCamera(0.f, 0.f, 0.f); }, "distance"));
+  EXPECT_EQ(e.camera().eye, good.eye) << "a refused camera changes nothing";
+  e.orbitCamera(0.f, 0.f, 0.5f);   // inside the volume: a fine view
+  e.orbitCamera(10.f, 90.f, 2.f);  // from the pole
+  e.setCamera(good);
+
+  PointLight light = e.light();
+  light.position.x = nan;
+  EXPECT_TRUE(refused([&] { e.setLight(light); }, "position must be finite"));
+  light = e.light();
+  light.intensity = -1.f;
+  EXPECT_TRUE(refused([&] { e.setLight(light); }, "intensity"));
+  light = e.light();
+  light.position = glm::vec3(1e30f);
+  EXPECT_TRUE(refused([&] { e.setLight(light); }, "bounding radii"));
+
+  RenderSettings rs;
+  rs.width = rs.height = 8;
+  for (float step : {1e-6f, 0.f, -1.f, 17.f, nan, std::numeric_limits<float>::infinity()}) {
+    rs.stepFactor = step;
+    EXPECT_TRUE(refused([&] { e.render(rs); }, "ray-march step")) << step;
+  }
+  rs.stepFactor = kMinStepFactor;
+  EXPECT_EQ(e.render(rs).width, 8);
+
+  const LevelSetSettings before = e.levelSetSettings();
+  LevelSetSettings ls = before;
+  ls.lambda = nan;
+  EXPECT_TRUE(refused([&] { e.setLevelSetSettings(ls); }, "lambda"));
+  ls = before;
+  ls.band = std::numeric_limits<float>::infinity();
+  EXPECT_TRUE(refused([&] { e.setLevelSetSettings(ls); }, "narrow band"));
+  ls = before;
+  ls.redistanceIterations = -1;
+  EXPECT_TRUE(refused([&] { e.setLevelSetSettings(ls); }, "redistancing iterations"));
+  EXPECT_EQ(e.levelSetSettings().lambda, before.lambda);
+}
+
+// A built-in scene that needs more memory than the process may still allocate is refused before
+// anything is allocated, also when the limit is the process's own (ulimit -v), not the
+// machine's: at 1024^3 the scene exhausted a 4 GB cap instead of being refused.
+TEST(EngineApi, ASceneLargerThanTheMemoryLeftIsRefusedUpFront) {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  size_t vmSize = 0;
+  while (std::getline(status, line))
+    if (line.rfind("VmSize:", 0) == 0) vmSize = size_t(std::stoull(line.substr(7))) * 1024u;
+  ASSERT_GT(vmSize, 0u);
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
+  rlimit capped = saved;
+  capped.rlim_cur = rlim_t(vmSize + (size_t(512) << 20));  // 512 MiB more than now
+  if (saved.rlim_max != RLIM_INFINITY && capped.rlim_cur > saved.rlim_max)
+    GTEST_SKIP() << "the hard address-space limit is already lower";
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &capped), 0);
+  Engine e;
+  // 512^3 voxels x 4 fields x 4 bytes = 2 GiB.
+  const bool refusedUpFront =
+      refused([&] { e.loadBuiltinScene("shepp-logan", 512); }, "GiB are available");
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  EXPECT_TRUE(refusedUpFront);
+  e.loadBuiltinScene("shepp-logan", 24);  // within the limit, once restored
 }

@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <vector>
@@ -19,9 +20,10 @@ std::vector<float> parseFloats(const std::string& text, char sep, const std::str
       size_t used = 0;
       float v = std::stof(part, &used);
       if (used != part.size()) throw std::invalid_argument(part);
+      if (!std::isfinite(v)) throw std::invalid_argument(part);  // stof takes "nan" and "inf"
       out.push_back(v);
     } catch (const std::exception&) {
-      throw Error(ErrorKind::Usage, what + ": '" + text + "' is not a list of numbers");
+      throw Error(ErrorKind::Usage, what + ": '" + text + "' is not a list of finite numbers");
     }
   }
   return out;

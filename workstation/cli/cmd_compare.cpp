@@ -46,6 +46,7 @@ Runner addCompareCommand(CLI::App& app) {
     }
     if (!o->camera.empty()) {
       glm::vec3 c = parseTriple(o->camera, "--camera");
+      checkOrbit(c.x, c.y, c.z, "--camera");
       engine.orbitCamera(c.x, c.y, c.z);
       engine.setLight(
           PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));

@@ -140,7 +140,10 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_flag("--json", o->json, "Print per-iteration statistics, stage times and memory as JSON");
   app.add_flag("--quiet", o->quiet, "No progress lines on stderr");
 
-  return [o]() {
+  return [o, &app]() {
+    // Options without a library default of their own apply only when given (any value: a NaN
+    // or a negative one is refused by the library, not taken for "not given").
+    auto given = [&app](const char* name) { return app.get_option(name)->count() > 0; };
     resetStageTimings();
     const auto t0 = std::chrono::steady_clock::now();
     const Colormap deviationColormap = parseColormap(o->deviationColormap);
@@ -157,6 +160,17 @@ Runner addOptimizeCommand(CLI::App& app) {
     s.tolerance = o->tolerance;
     s.frustumScale = o->frustumScale;
     const glm::ivec2 size = parseSize(o->size);
+    // Checked before anything runs: a bad output path or second view must not cost a whole
+    // optimisation.
+    if (!o->out.empty()) {
+      checkPngOutput(o->out);
+      checkPngOutput(beforePath(o->out));
+    }
+    glm::vec3 viewFrom(0.f);
+    if (!o->viewFrom.empty()) {
+      viewFrom = parseTriple(o->viewFrom, "--view-from");
+      checkOrbit(viewFrom.x, viewFrom.y, viewFrom.z, "--view-from");
+    }
     loadInput(engine, o->volume, o->scene, o->resolution, !o->json && !o->quiet);
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
     // --importance preset:NAME, or, without --importance, the importance the --tf preset is
@@ -177,12 +191,12 @@ Runner addOptimizeCommand(CLI::App& app) {
       engine.loadImportance(o->importance);
     }
     LevelSetSettings ls = engine.levelSetSettings();
-    if (o->lambda >= 0.f) ls.lambda = o->lambda;
-    if (o->redistIterations >= 0) ls.redistanceIterations = o->redistIterations;
-    if (o->reach >= 0.f) ls.reach = o->reach;
-    if (o->band >= 0.f) ls.band = o->band;
+    if (given("--lambda")) ls.lambda = o->lambda;
+    if (given("--redist-iterations")) ls.redistanceIterations = o->redistIterations;
+    if (given("--level-set-reach")) ls.reach = o->reach;
+    if (given("--level-set-band")) ls.band = o->band;
     engine.setLevelSetSettings(ls);
-    if ((o->shell >= 0.f || o->filled) && !engine.contextSurfaces().empty()) {
+    if ((given("--shell") || o->filled) && !engine.contextSurfaces().empty()) {
       // --shell and --filled apply to a scene's own context surfaces too.
       std::vector<ContextSurfaceSpec> own = engine.contextSurfaces();
       engine.clearContextSurfaces();
@@ -197,7 +211,7 @@ Runner addOptimizeCommand(CLI::App& app) {
       spec.source = c;
       if (o->filled) {
         spec.filled = true;
-      } else if (o->shell >= 0.f) {
+      } else if (given("--shell")) {
         spec.filled = false;
         spec.shell = o->shell;
       } else {
@@ -225,12 +239,13 @@ Runner addOptimizeCommand(CLI::App& app) {
     const Bounds bounds = engine.volume().grid().worldBounds();
     if (!o->camera.empty()) {
       glm::vec3 c = parseTriple(o->camera, "--camera");
-      if (!(c.z > 0.f)) throw Error(ErrorKind::Usage, "--camera: distance must be positive");
+      checkOrbit(c.x, c.y, c.z, "--camera");
       engine.orbitCamera(c.x, c.y, c.z);
       engine.setLight(PointLight::keyLightFor(engine.camera(), bounds));
     }
     if (!o->light.empty()) {
       glm::vec3 l = parseTriple(o->light, "--light");
+      checkOrbit(l.x, l.y, l.z, "--light");
       PointLight light = engine.light();
       light.position = Camera::orbitBounds(bounds, l.x, l.y, l.z).eye;
       engine.setLight(light);
@@ -272,9 +287,8 @@ Runner addOptimizeCommand(CLI::App& app) {
       renderMs = msSince(tr);
       images["after"] = o->out;
       if (!o->viewFrom.empty()) {
-        glm::vec3 v = parseTriple(o->viewFrom, "--view-from");
         engine.setFrozen(true);
-        engine.orbitCamera(v.x, v.y, v.z);
+        engine.orbitCamera(viewFrom.x, viewFrom.y, viewFrom.z);
         std::filesystem::path p(o->out);
         const std::string viewPath =
             (p.parent_path() / (p.stem().string() + "-view" + p.extension().string())).string();

@@ -55,6 +55,7 @@ Runner addRenderCommand(CLI::App& app) {
     resetStageTimings();
     const auto t0 = std::chrono::steady_clock::now();
     auto given = [&app](const char* name) { return app.get_option(name)->count() > 0; };
+    checkPngOutput(o->out);  // before any loading: a device or folder is refused up front
     // A session supplies the scene and the render settings; explicit options override them.
     std::optional<Session> session;
     if (!o->session.empty()) session = loadSession(o->session);
@@ -84,7 +85,7 @@ Runner addRenderCommand(CLI::App& app) {
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
     if (!o->camera.empty()) {
       glm::vec3 c = parseTriple(o->camera, "--camera");
-      if (!(c.z > 0.f)) throw Error(ErrorKind::Usage, "--camera: distance must be positive");
+      checkOrbit(c.x, c.y, c.z, "--camera");
       engine.orbitCamera(c.x, c.y, c.z);
       engine.setLight(
           PointLight::keyLightFor(engine.camera(), engine.volume().grid().worldBounds()));

@@ -23,6 +23,20 @@ struct Camera {
   glm::vec3 forward() const { return glm::normalize(target - eye); }
 };
 
+// The orbit distances a view may use, in bounding-sphere radii: nearer than kMinOrbitRadii the
+// camera sits on the volume's centre (no view direction in float), farther than kMaxOrbitRadii
+// the volume is below a pixel and float products of world positions overflow.
+inline constexpr float kMinOrbitRadii = 1e-3f;
+inline constexpr float kMaxOrbitRadii = 1e4f;
+
+// Throws Error(Usage) naming `what` unless the camera can render `bounds`: finite eye, target
+// and up, a field of view of 1..170 degrees, the eye kMinOrbitRadii..kMaxOrbitRadii bounding
+// radii from the target and within kMaxOrbitRadii of the bounds' centre, up not along the view.
+void checkCamera(const Camera& camera, const Bounds& bounds, const char* what = "camera");
+// The same for orbit angles and distance (finite angles, distance in radii within the range).
+void checkOrbit(float azimuthDeg, float elevationDeg, float distanceInRadii,
+                const char* what = "camera");
+
 struct PointLight {
   glm::vec3 position{0.f, -3.f, 3.f};
   float intensity = 1.f;  // L_e of paper 000 Eq. 9 (no quadratic fall-off, as in the paper)
@@ -31,5 +45,9 @@ struct PointLight {
   // A light above-left of the camera, a photographer's key light: the default for scenes.
   static PointLight keyLightFor(const Camera& camera, const Bounds& bounds);
 };
+
+// Throws Error(Usage) unless the light is usable with `bounds`: a finite position within
+// kMaxOrbitRadii bounding radii of the centre, finite non-negative intensity and colour.
+void checkLight(const PointLight& light, const Bounds& bounds, const char* what = "light");
 
 }  // namespace visopt

@@ -23,6 +23,9 @@ struct Image {
 
 // Writes an 8-bit sRGB PNG atomically (temporary file, then rename). Throws Error(Failure).
 void writePng(const Image& image, const std::string& path);
+// Throws Error(Usage) unless writePng may write `path` (a regular file, a link or a new path;
+// not a folder, device, pipe or socket): check before the work whose result it will hold.
+void checkPngOutput(const std::string& path);
 // Reads an 8-bit PNG back into linear RGB (for tests and comparisons).
 Image readPng(const std::string& path);
 // Peak signal-to-noise ratio in dB of two equally sized images over sRGB-encoded values.

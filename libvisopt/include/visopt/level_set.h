@@ -51,6 +51,9 @@ struct LevelSetSettings {
 // rising under the curvature term without any surface moving).
 constexpr float kNearSurfaceBand = 1.f;
 
+// Throws Error(Usage) naming the setting unless every value is finite and in its range.
+void checkLevelSetSettings(const LevelSetSettings& settings);
+
 struct LevelSetStepStats {
   double timeStep = 0.0;  // dt of one substep
   int substeps = 0;

@@ -18,13 +18,19 @@ enum class RenderMethod {
 };
 const char* toString(RenderMethod method);
 
+// The ray-march steps a render accepts, in units of the smallest voxel spacing: finer than 1/20
+// of a voxel changes no pixel visibly and multiplies the time (a step of 1e-6 ran for hours);
+// coarser than 16 voxels skips whole structures.
+inline constexpr float kMinStepFactor = 0.05f;
+inline constexpr float kMaxStepFactor = 16.f;
+
 struct RenderSettings {
   RenderMethod method = RenderMethod::Optimized;
   float cutAwayThreshold = 0.3f;  // ghat above this is cut away
   int width = 512, height = 512;
   // Ray-marching step, in units of the smallest voxel spacing. Each pixel's samples are
   // stratified with a per-pixel random offset (jitter) against wood-grain artefacts.
-  float stepFactor = 0.5f;
+  float stepFactor = 0.5f;  // kMinStepFactor..kMaxStepFactor
   bool jitter = true;
   uint32_t seed = 1;
   // Preview: render at 1/previewFactor of the size with twice the step, then upscale.

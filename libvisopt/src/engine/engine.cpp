@@ -74,6 +74,8 @@ struct Engine::Impl {
     if (!volume) throw Error(ErrorKind::Usage, "no volume loaded");
     if (!importance)
       throw Error(ErrorKind::Usage, "no importance: give an importance curve or volume first");
+    checkCamera(camera, volume->grid().worldBounds());
+    checkLight(light, volume->grid().worldBounds());
     ensureTable();
     OptimizationInputs in;
     in.volume = &*volume;
@@ -253,6 +255,7 @@ const TransferFunction& Engine::transferFunction() const {
 }
 
 void Engine::setCamera(const Camera& camera) {
+  if (impl_->volume) checkCamera(camera, impl_->volume->grid().worldBounds());
   impl_->camera = camera;
 }
 const Camera& Engine::camera() const {
@@ -261,11 +264,15 @@ const Camera& Engine::camera() const {
 
 void Engine::orbitCamera(float azimuthDeg, float elevationDeg, float distanceInRadii) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
-  impl_->camera = Camera::orbitBounds(impl_->volume->grid().worldBounds(), azimuthDeg, elevationDeg,
-                                      distanceInRadii);
+  checkOrbit(azimuthDeg, elevationDeg, distanceInRadii);
+  const Bounds bounds = impl_->volume->grid().worldBounds();
+  const Camera camera = Camera::orbitBounds(bounds, azimuthDeg, elevationDeg, distanceInRadii);
+  checkCamera(camera, bounds);
+  impl_->camera = camera;
 }
 
 void Engine::setLight(const PointLight& light) {
+  if (impl_->volume) checkLight(light, impl_->volume->grid().worldBounds());
   impl_->light = light;
   impl_->lightDirty = true;
 }
@@ -276,6 +283,10 @@ const PointLight& Engine::light() const {
 Image Engine::render(const RenderSettings& settings, RenderStats* stats,
                      const std::function<bool()>& abandon) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
+  // A camera or light set before the volume (or one a session carried) meets its bounds here.
+  const Bounds bounds = impl_->volume->grid().worldBounds();
+  checkCamera(impl_->camera, bounds);
+  checkLight(impl_->light, bounds);
   impl_->ensureTable();
   const bool optimized = settings.method == RenderMethod::Optimized;
   if (optimized != impl_->lightOptimized) impl_->lightDirty = true;  // T_L of the other scene
@@ -378,6 +389,7 @@ const Field3D* Engine::contextSurfaceBase(int index) const {
 }
 
 void Engine::setLevelSetSettings(const LevelSetSettings& settings) {
+  checkLevelSetSettings(settings);
   impl_->levelSet = settings;
 }
 const LevelSetSettings& Engine::levelSetSettings() const {

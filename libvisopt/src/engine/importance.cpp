@@ -9,6 +9,7 @@
 
 #include "core/field_view.h"
 #include "exec/parallel.h"
+#include "io/file_util.h"
 #include "visopt/error.h"
 #include "visopt/transfer_function.h"
 #include "visopt/volume_io.h"
@@ -82,6 +83,7 @@ bool isCurveFile(const std::string& path) {
 }
 
 std::vector<glm::dvec2> readImportanceCurve(const std::string& path) {
+  io::checkedFileSize(path, io::kMaxTextInputBytes, "an importance curve");
   std::ifstream file(path);
   if (!file) throwBadInput(path, "cannot open the importance curve");
   std::stringstream ss;

@@ -54,9 +54,23 @@ uint64_t checkedFileSize(const std::string& path) {
   fs::file_status status = fs::status(path, ec);
   if (ec || !fs::exists(status)) throwBadInput(path, "file not found");
   if (fs::is_directory(status)) throwBadInput(path, "is a folder, not a file");
+  // A device or a FIFO would be read without end (/dev/zero) or block (a pipe nobody writes).
+  if (!fs::is_regular_file(status))
+    throwBadInput(path, "is a device, pipe or socket, not a regular file");
   uint64_t size = fs::file_size(path, ec);
   if (ec) throwBadInput(path, "cannot read file size (" + ec.message() + ")");
   if (size == 0) throwBadInput(path, "file is empty");
+  return size;
+}
+
+uint64_t checkedFileSize(const std::string& path, uint64_t maxBytes, std::string_view kind) {
+  const uint64_t size = checkedFileSize(path);
+  if (size > maxBytes) {
+    char limit[64];
+    std::snprintf(limit, sizeof limit, "%.0f MiB", double(maxBytes) / double(1 << 20));
+    throwBadInput(path,
+                  "is larger than " + std::string(limit) + ", too large for " + std::string(kind));
+  }
   return size;
 }
 
@@ -162,7 +176,22 @@ ScalarData readCompressedPayload(const std::string& path, uint64_t offset, Scala
   return makeScalarData(std::move(buffer), type, count);
 }
 
+void checkOutputTarget(const std::string& path) {
+  // The temporary is renamed over the target: over a device that replaced the device itself
+  // (as root, --out /dev/full became a PNG). Only regular files, links and new paths are written.
+  std::error_code ec;
+  const fs::file_status target = fs::symlink_status(path, ec);
+  if (!ec && fs::exists(target)) {
+    if (fs::is_directory(target))
+      throw Error(ErrorKind::Usage, path + ": is a folder; give a file name to write");
+    if (!fs::is_regular_file(target) && !fs::is_symlink(target))
+      throw Error(ErrorKind::Usage,
+                  path + ": is a device, pipe or socket; visopt writes only regular files");
+  }
+}
+
 std::string makeTemporarySibling(const std::string& path, const std::string& suffix) {
+  checkOutputTarget(path);
   std::string pattern = path + ".tmp-XXXXXX" + suffix;
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');

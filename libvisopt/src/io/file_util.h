@@ -21,6 +21,12 @@ std::string siblingPath(const std::string& headerPath, const std::string& name);
 // Size of a regular, non-empty file; throws BadInput "file not found", "is a folder, not a
 // file", "file is empty" otherwise.
 uint64_t checkedFileSize(const std::string& path);
+// The same, refusing a file larger than maxBytes ("PATH: is larger than N MiB, too large for
+// KIND"): for text inputs (transfer functions, sessions, curves) that are read whole.
+uint64_t checkedFileSize(const std::string& path, uint64_t maxBytes, std::string_view kind);
+// Text inputs are read whole: this bounds what a wrong path (a volume given as a transfer
+// function) can make visopt read.
+inline constexpr uint64_t kMaxTextInputBytes = uint64_t(64) << 20;
 
 // Reads `count` scalars of `type` starting at byte `offset` of `path`, swapping bytes when the
 // file's byte order differs from the host's. Throws BadInput "truncated: ..." when the file is
@@ -39,6 +45,9 @@ void swapBytesInPlace(void* data, size_t count, size_t elementSize);
 // "dir/a.nii.gz.tmp-XXXXXX.nii.gz" (keeping `suffix` so writers that look at the extension
 // behave); commitTemporary renames it over `path`; discardTemporary removes it.
 std::string makeTemporarySibling(const std::string& path, const std::string& suffix);
+// Throws Error(Usage) when `path` names a folder, a device, a pipe or a socket (what
+// makeTemporarySibling refuses to replace), so that a caller can refuse before its work.
+void checkOutputTarget(const std::string& path);
 void commitTemporary(const std::string& temporary, const std::string& path);
 void discardTemporary(const std::string& temporary) noexcept;
 

@@ -58,6 +58,10 @@ std::vector<uint8_t> Image::toSrgb8() const {
   return out;
 }
 
+void checkPngOutput(const std::string& path) {
+  io::checkOutputTarget(path);
+}
+
 void writePng(const Image& image, const std::string& path) {
   if (image.width <= 0 || image.height <= 0 ||
       image.pixels.size() != size_t(image.width) * size_t(image.height))

@@ -789,8 +789,47 @@ void validate(const OptimizationInputs& in, const ExtinctionSettings& s) {
     throw Error(ErrorKind::Usage, "frustum scale must be in (0, 4]");
   if (in.importance->grid().dims != in.volume->grid().dims)
     throw Error(ErrorKind::Usage, "importance and volume grids differ");
+  auto require = [](bool ok, const char* message) {
+    if (!ok) throw Error(ErrorKind::Usage, message);
+  };
+  // Every number reaches the kernels: a NaN or an infinity must stop here, not as NaN fields.
+  require(finite(s.tolerance) && s.tolerance >= 0.f, "the energy tolerance must be finite, >= 0");
+  require(s.beta1 >= 0.f && s.beta1 < 1.f && s.beta2 >= 0.f && s.beta2 < 1.f && s.beta3 >= 0.f &&
+              s.beta3 < 1.f,
+          "the optimiser's betas must lie in [0, 1)");
+  require(finite(s.alpha) && s.alpha >= 0.f, "AdEMAMix's alpha must be finite, >= 0");
+  require(finite(s.epsilon) && s.epsilon > 0.f, "the optimiser's epsilon must be finite, > 0");
+  require(s.maxIterationsPerLevel <= 1000000, "iterations must be at most 1000000 per level");
+  require(s.depthCells >= 0 && s.depthCells <= 8192, "depth cells must be 0 (automatic)..8192");
+  require(s.lightGridSize >= 4 && s.lightGridSize <= 8192, "the light grid must be 4..8192 rays");
+  const ImportanceLens& lens = in.lens;
+  require(finite(lens.x) && finite(lens.y) && finite(lens.radius) && lens.radius >= 0.f &&
+              finite(lens.strength) && lens.strength >= 0.f && lens.strength <= 1e3f,
+          "the lens needs a finite centre, a radius >= 0 and a strength of 0..1000");
+  checkLevelSetSettings(in.levelSet);
 }
 }  // namespace
+
+void checkLevelSetSettings(const LevelSetSettings& ls) {
+  auto finite = [](float v) { return std::isfinite(v); };
+  auto require = [](bool ok, const char* message) {
+    if (!ok) throw Error(ErrorKind::Usage, message);
+  };
+  require(finite(ls.lambda) && ls.lambda >= 0.f, "lambda must be finite, >= 0");
+  require(finite(ls.curvatureEpsilon) && ls.curvatureEpsilon > 0.f,
+          "the curvature epsilon must be finite, > 0");
+  require(ls.cfl > 0.f && ls.cfl <= 1.f, "the level-set CFL number must lie in (0, 1]");
+  require(ls.substeps >= 0 && ls.substeps <= 4096, "level-set substeps must be 0..4096");
+  require(finite(ls.reach) && ls.reach >= 0.f && ls.reach <= 100.f,
+          "the level-set reach must be 0..100 bounding radii");
+  require(ls.redistanceIterations >= 0 && ls.redistanceIterations <= 100000,
+          "redistancing iterations must be 0..100000");
+  require(finite(ls.redistanceTolerance) && ls.redistanceTolerance >= 0.f,
+          "the redistancing tolerance must be finite, >= 0");
+  require(ls.spatialOrder == 1 || ls.spatialOrder == 2, "the spatial order must be 1 or 2");
+  require(finite(ls.band) && ls.band >= 0.f && ls.band <= 1e4f,
+          "the narrow band must be 0 (dense)..10000 voxels");
+}
 
 std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const OptimizationInputs& in,
                                                               const ExtinctionSettings& s,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "core/field_view.h"
 #include "core/frustum_map.h"
@@ -143,7 +144,13 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   if (settings.width <= 0 || settings.height <= 0 || settings.width > 16384 ||
       settings.height > 16384)
     throw Error(ErrorKind::Usage, "image size must be between 1 and 16384 pixels per side");
-  if (!(settings.stepFactor > 0.f)) throw Error(ErrorKind::Usage, "step factor must be positive");
+  if (!(settings.stepFactor >= kMinStepFactor && settings.stepFactor <= kMaxStepFactor)) {
+    char message[128];
+    std::snprintf(message, sizeof message,
+                  "the ray-march step must be %g..%g times the smallest voxel spacing",
+                  double(kMinStepFactor), double(kMaxStepFactor));
+    throw Error(ErrorKind::Usage, message);
+  }
   const auto start = std::chrono::steady_clock::now();
   const bool preview = settings.preview && settings.previewFactor > 1;
   const int w = preview ? std::max(1, settings.width / settings.previewFactor) : settings.width;

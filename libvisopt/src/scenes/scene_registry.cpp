@@ -1,9 +1,14 @@
 // Names, descriptions and dispatch of the built-in scenes.
+#include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
+#include "scenes/scene_common.h"
 #include "scenes/scene_makers.h"
 #include "visopt/error.h"
+#include "visopt/precision.h"
+#include "visopt/volume_io.h"
 
 namespace visopt {
 
@@ -51,7 +56,25 @@ std::string defaultSceneName() {
 BuiltinScene makeBuiltinScene(const std::string& name, int resolution, Precision precision,
                               MemoryLedger* ledger) {
   for (const Entry& e : kScenes)
-    if (name == e.name) return e.make(resolution, precision, ledger);
+    if (name == e.name) {
+      scenes::checkResolution(name, resolution);
+      // Refused before anything is allocated: a scene holds about kSceneFields fields of
+      // resolution^3 values while it is made (the volume, its importance, a context surface's
+      // base SDF and the generator's own), and at 1024^3 that exceeded the machine.
+      constexpr double kSceneFields = 4.0;
+      const double bytes =
+          std::pow(double(resolution), 3.0) * double(bytesPerValue(precision)) * kSceneFields;
+      const double available = double(availableMemoryBytes());
+      if (bytes > available) {
+        char message[256];
+        std::snprintf(message, sizeof message,
+                      "scene %s: resolution %d needs about %.1f GiB, %.1f GiB are available",
+                      name.c_str(), resolution, bytes / double(1 << 30),
+                      available / double(1 << 30));
+        throw Error(ErrorKind::Usage, message);
+      }
+      return e.make(resolution, precision, ledger);
+    }
   std::string known;
   for (const Entry& e : kScenes) known += (known.empty() ? "" : ", ") + std::string(e.name);
   throw Error(ErrorKind::Usage, "unknown built-in scene '" + name + "' (known: " + known + ")");

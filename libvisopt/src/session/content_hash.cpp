@@ -52,6 +52,11 @@ std::vector<FileEntry> listEntries(const std::string& path) {
 }
 
 void hashFile(Sha256& h, const fs::path& path) {
+  // Only regular files: a session must not make visopt read a device (/dev/zero never ends)
+  // or block on a FIFO.
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::status(path, ec)))
+    throwBadInput(path.string(), "is not a regular file; only data files are checked");
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) throwBadInput(path.string(), std::string("cannot open: ") + std::strerror(errno));
   std::vector<char> buffer(1 << 20);

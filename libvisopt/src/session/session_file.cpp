@@ -121,6 +121,8 @@ Session loadSession(const std::string& path) {
   const fs::file_status st = fs::status(path, ec);
   if (ec || !fs::exists(st)) throwBadInput(path, "file not found");
   if (fs::is_directory(st)) throwBadInput(path, "is a folder, not a session file");
+  if (!fs::is_regular_file(st))
+    throwBadInput(path, "is a device, pipe or socket, not a session file");
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) throwBadInput(path, "cannot read its size (" + ec.message() + ")");
   if (size == 0) throwBadInput(path, "file is empty");

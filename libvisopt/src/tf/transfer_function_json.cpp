@@ -148,8 +148,12 @@ TransferFunction TransferFunction::load(const std::string& path) {
   const fs::file_status st = fs::status(path, ec);
   if (!fs::exists(st)) throwBadInput(path, "no such file");
   if (fs::is_directory(st)) throwBadInput(path, "is a directory, not a transfer-function file");
+  // A device or FIFO has no size and would be read without end (/dev/zero) or block.
+  if (!fs::is_regular_file(st))
+    throwBadInput(path, "is a device, pipe or socket, not a transfer-function file");
   const auto bytes = fs::file_size(path, ec);
-  if (!ec && bytes > kMaxFileBytes) throwBadInput(path, "file too large for a transfer function");
+  if (ec) throwBadInput(path, "cannot read its size (" + ec.message() + ")");
+  if (bytes > kMaxFileBytes) throwBadInput(path, "file too large for a transfer function");
   std::ifstream in(path, std::ios::binary);
   if (!in) throwBadInput(path, "cannot open for reading");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -584,12 +584,22 @@ void MainWindow::openBuiltinScene(const QString& name, int resolution) {
 void MainWindow::openVolume(const QString& path) {
   sceneLoading_ = true;
   const std::string p = path.toStdString();
-  controller_->postLong(tr("Volume %1").arg(path),
-                        [this, p](Engine& e, const ProgressCallback& progress) {
-                          e.loadVolume(p, progress);
-                          e.resetOptimization();
-                          controller_->refreshSnapshot(e, true);
-                        });
+  controller_->postLong(
+      tr("Volume %1").arg(path), [this, p](Engine& e, const ProgressCallback& progress) {
+        e.loadVolume(p, progress);
+        e.resetOptimization();
+        controller_->refreshSnapshot(e, true);
+        // Accepted with a caveat (DICOM spacing jitter, ...): say so.
+        QStringList warnings;
+        for (const std::string& w : e.volume().warnings) warnings << QString::fromStdString(w);
+        if (!warnings.isEmpty())
+          QMetaObject::invokeMethod(
+              this,
+              [this, warnings] {
+                statusBar()->showMessage(warnings.join(QStringLiteral("; ")), 30000);
+              },
+              Qt::QueuedConnection);
+      });
   controller_->restartOptimization();
   sessionPath_.clear();
   syncPanelsFromEngine();

@@ -63,6 +63,8 @@ void loadInput(Engine& engine, const std::string& volume, const std::string& sce
       return true;
     };
   engine.loadVolume(volume, progress);
+  for (const std::string& w : engine.volume().warnings)
+    std::fprintf(stderr, "visopt: warning: %s\n", w.c_str());
 }
 
 TransferFunction loadTransferFunction(const std::string& spec, const Volume& volume) {

@@ -31,7 +31,8 @@ Runner addInfoCommand(CLI::App& app) {
           {"scalar_type", info.scalarType},
           {"range", {info.valueMin, info.valueMax}},
           {"bytes_on_disk", info.bytesOnDisk},
-          {"memory", {{"fp32_bytes", info.bytesFp32}, {"fp16_bytes", info.bytesFp16}}}};
+          {"memory", {{"fp32_bytes", info.bytesFp32}, {"fp16_bytes", info.bytesFp16}}},
+          {"warnings", info.warnings}};
       std::printf("%s\n", j.dump(2).c_str());
     } else {
       std::printf("file:     %s (%s)\n", info.path.c_str(), info.format.c_str());
@@ -44,6 +45,7 @@ Runner addInfoCommand(CLI::App& app) {
       std::printf("range:    %g .. %g\n", info.valueMin, info.valueMax);
       std::printf("memory:   %s as fp32, %s as fp16\n", humanBytes(info.bytesFp32).c_str(),
                   humanBytes(info.bytesFp16).c_str());
+      for (const std::string& w : info.warnings) std::printf("warning:  %s\n", w.c_str());
     }
     return kOk;
   };

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "visopt/field.h"
 #include "visopt/grid.h"
@@ -17,6 +18,10 @@ struct Volume {
   double valueMin = 0.0;
   double valueMax = 1.0;
   Field3D normalized;  // (value - valueMin) / (valueMax - valueMin)
+  // What the reader accepted but a user should know, one line each, naming the file (a DICOM
+  // series whose slice spacing varies within the tolerance, ...). Shown by the CLI and the
+  // workstation; empty for clean data.
+  std::vector<std::string> warnings;
 
   const GridSpec& grid() const { return normalized.grid(); }
   double toValue(float t) const { return valueMin + t * (valueMax - valueMin); }

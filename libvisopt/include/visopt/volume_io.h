@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "visopt/grid.h"
 #include "visopt/precision.h"
@@ -26,9 +27,10 @@ struct VolumeInfo {
   std::string scalarType;  // "uint8", "int16", "float32", ...
   GridSpec grid;
   double valueMin = 0.0, valueMax = 0.0;
-  size_t bytesOnDisk = 0;  // of the scalar payload, as stored
-  size_t bytesFp32 = 0;    // what visopt needs to hold the scalars as fp32
-  size_t bytesFp16 = 0;    // ... and as fp16
+  size_t bytesOnDisk = 0;             // of the scalar payload, as stored
+  size_t bytesFp32 = 0;               // what visopt needs to hold the scalars as fp32
+  size_t bytesFp16 = 0;               // ... and as fp16
+  std::vector<std::string> warnings;  // as Volume::warnings
 };
 
 // Reads the whole file (values are needed for the range) and describes it.

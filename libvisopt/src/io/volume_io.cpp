@@ -123,6 +123,7 @@ VolumeInfo probeVolume(const std::string& path, const ProgressCallback& progress
     info.bytesOnDisk = lv.scalars.count * io::scalarTypeSize(lv.scalars.type);
     info.bytesFp32 = lv.scalars.count * 4;
     info.bytesFp16 = lv.scalars.count * 2;
+    info.warnings = lv.warnings;
     io::reportProgress(progress, path, 1.f, "converted");
     return info;
   });
@@ -149,6 +150,7 @@ Volume readVolume(const std::string& path, Precision precision, MemoryLedger* le
     volume.scalarType = scalarTypeText(lv.scalars);
     volume.valueMin = stats.lo;
     volume.valueMax = stats.hi;
+    volume.warnings = lv.warnings;
     volume.normalized = Field3D("volume", lv.grid, precision, ledger);
     normalizeInto(lv.scalars, stats.lo, stats.hi, volume.normalized);
     io::reportProgress(progress, path, 1.f, "converted");

@@ -11,6 +11,7 @@
 // restored here.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -34,6 +35,13 @@
 namespace visopt::io {
 
 namespace {
+
+// A gap between neighbouring slices may differ from the series' median gap by this fraction
+// of it (a missing slice doubles a gap, an extra one halves it); within it the series loads on
+// its mean spacing, with a warning once the gaps vary by more than kSliceJitterWarning mm
+// (Slicer's default tolerance for irregular geometry).
+constexpr double kSliceGapTolerance = 0.25;
+constexpr double kSliceJitterWarning = 0.01;
 
 // DICOMParser reports some problems straight to std::cerr; keep them off the terminal.
 class CerrSilencer {
@@ -165,17 +173,45 @@ LoadedVolume readDicomSeries(const std::string& path, const ProgressCallback& pr
   std::sort(slices.begin(), slices.end(),
             [](const Slice& a, const Slice& b) { return a.along < b.along; });
   double sliceSpacing = 1.0;
+  std::vector<std::string> warnings;
   if (slices.size() > 1) {
     sliceSpacing = (slices.back().along - slices.front().along) / double(slices.size() - 1);
     for (size_t s = 1; s < slices.size(); ++s)
       if (!(slices[s].along - slices[s - 1].along > 1e-6))
         throwBadInput(path, fileName(slices[s].file) + " and " + fileName(slices[s - 1].file) +
                                 ": two slices at the same position");
-    for (size_t s = 1; s < slices.size(); ++s) {
-      const double gap = slices[s].along - slices[s - 1].along;
-      if (std::abs(gap - sliceSpacing) > 0.01 * sliceSpacing + 1e-4)
-        throwBadInput(path,
-                      "uneven slice spacing (missing slices?) near " + fileName(slices[s].file));
+    // Clinical series carry positions rounded to a few decimals, and a slightly oblique stack
+    // projects them unevenly onto the normal: gaps of 6.96-7.07 mm in a 7 mm series are normal.
+    // ITK's ImageSeriesReader and Slicer load such series with a warning (Slicer's default
+    // tolerance is 0.01 mm) on the mean spacing; so does visopt. Refused is only a real gap, a
+    // missing or an extra slice: a gap off the median by more than kSliceGapTolerance of it.
+    std::vector<double> gaps;
+    for (size_t s = 1; s < slices.size(); ++s)
+      gaps.push_back(slices[s].along - slices[s - 1].along);
+    std::vector<double> sorted = gaps;
+    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    double lo = gaps.front(), hi = gaps.front();
+    for (size_t s = 0; s < gaps.size(); ++s) {
+      if (std::abs(gaps[s] - median) > kSliceGapTolerance * median) {
+        char message[256];
+        std::snprintf(message, sizeof message,
+                      "%s and %s are %.4g mm apart where the series' slices are %.4g mm apart "
+                      "(a missing or extra slice?)",
+                      fileName(slices[s].file).c_str(), fileName(slices[s + 1].file).c_str(),
+                      gaps[s], median);
+        throwBadInput(path, message);
+      }
+      lo = std::min(lo, gaps[s]);
+      hi = std::max(hi, gaps[s]);
+    }
+    if (hi - lo > kSliceJitterWarning) {
+      char message[256];
+      std::snprintf(message, sizeof message,
+                    "%s: slice spacing varies from %.4g to %.4g mm (positions rounded in the "
+                    "headers, or an oblique stack); using the mean, %.4g mm",
+                    path.c_str(), lo, hi, sliceSpacing);
+      warnings.push_back(message);
     }
   }
 
@@ -191,6 +227,7 @@ LoadedVolume readDicomSeries(const std::string& path, const ProgressCallback& pr
   }
   LoadedVolume out;
   out.format = "dicom";
+  out.warnings = std::move(warnings);
   out.grid = checkHeader(path, h);  // before any pixel data is read
   reportProgress(progress, path, 0.1f, "header");
 

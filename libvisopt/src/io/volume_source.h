@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "io/scalar_type.h"
 #include "visopt/grid.h"
@@ -44,6 +45,7 @@ struct LoadedVolume {
   std::string format;  // "nifti", "metaimage", "vti", "vtk-legacy", "nrrd", "dicom", "raw", ...
   GridSpec grid;
   ScalarData scalars;
+  std::vector<std::string> warnings;  // accepted, but the user should know (Volume::warnings)
 };
 
 // Checks dims (> 0, fits in int, product and fp32 bytes do not overflow, fp32 bytes fit in

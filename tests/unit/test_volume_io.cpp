@@ -771,6 +771,28 @@ TEST(VolumeIoBadInput, TruncatedAndLyingHeaders) {
   writeBytes(
       mha, "NDims = 3\nDimSize = 5 4 9\nElementType = MET_SHORT\nElementDataFile = LOCAL\n" + full);
   expectReadBad(mha, "truncated");
+  // A detached MetaImage whose data file is short or missing: the message names the header the
+  // user opened first, then the data file (it named only the data file, which the user never
+  // chose).
+  const std::string mhd = join(dir, "scan.mhd");
+  writeBytes(join(dir, "scan.raw"), full.substr(0, 40));
+  writeBytes(mhd,
+             "NDims = 3\nDimSize = 5 4 3\nElementType = MET_SHORT\nElementDataFile = scan.raw\n");
+  for (const std::string& data : {std::string("scan.raw"), std::string("gone.raw")}) {
+    if (data == "gone.raw")
+      writeBytes(
+          mhd, "NDims = 3\nDimSize = 5 4 3\nElementType = MET_SHORT\nElementDataFile = gone.raw\n");
+    try {
+      (void)readVolume(mhd, Precision::FP32);
+      ADD_FAILURE() << "no error for " << data;
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(mhd + ": its data file ", 0), 0u) << msg;
+      EXPECT_NE(msg.find(data), std::string::npos) << msg;
+      EXPECT_NE(msg.find(data == "gone.raw" ? "file not found" : "truncated"), std::string::npos)
+          << msg;
+    }
+  }
   // Compressed MetaImage cut short.
   std::string z = gzipBytes(full, 15);
   std::string zmha = join(dir, "cut.mha");

@@ -34,7 +34,20 @@ LoadedVolume loadAnyVolume(const std::string& path, const ProgressCallback& prog
       {".inr", io::readInrimage},  {".plt", io::readGOpenMolPlt},
   };
   for (const Entry& e : entries)
-    if (io::endsWithNoCase(path, e.suffix)) return e.read(path, progress);
+    if (io::endsWithNoCase(path, e.suffix)) {
+      try {
+        return e.read(path, progress);
+      } catch (const Error& error) {
+        // A header's data file (scan.mhd -> scan.raw) is not what the user opened: name the
+        // opened file first ("scan.mhd: its data file scan.raw: truncated ..."), or the message
+        // points at a file the user never chose.
+        const std::string message = error.what();
+        if (error.kind() != ErrorKind::BadInput || message.rfind(path + ":", 0) == 0) throw;
+        const bool sidecar = io::endsWithNoCase(path, ".raw");  // vol.raw's header vol.raw.json
+        throw Error(ErrorKind::BadInput,
+                    path + (sidecar ? ": its header " : ": its data file ") + message);
+      }
+    }
   if (!std::filesystem::exists(path, ec)) throwBadInput(path, "file not found");
   std::string ext = std::filesystem::path(path).extension().string();
   throwBadInput(path, "unknown volume format" + (ext.empty() ? std::string() : " '" + ext + "'") +

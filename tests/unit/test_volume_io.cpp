@@ -956,6 +956,21 @@ TEST(VolumeIoBadInput, GeometryAndSidecarProblems) {
              "MET_SHORT\nElementDataFile = LOCAL\n" +
                  data);
   expectReadBad(mha, "invalid spacing");
+  // Finite but beyond what fp32 geometry can carry (issue 13: renders of such files, which the
+  // readers accepted, segfaulted): spacings of 1e30 and 1e-30, an origin of -3e38, and a spacing
+  // ratio of 1e20 (a ray-march step of a fraction of the smallest would never cross the box).
+  expectReadBad(sidecar("huge.raw", R"({"dims":[5,4,3],"type":"int16","spacing":[1e30,1,1]})"),
+                "out of range");
+  expectReadBad(sidecar("tiny.raw", R"({"dims":[5,4,3],"type":"int16","spacing":[1e-30,1,1]})"),
+                "out of range");
+  expectReadBad(sidecar("far.raw", R"({"dims":[5,4,3],"type":"int16","origin":[0,-3e38,0]})"),
+                "out of range");
+  expectReadBad(sidecar("flat.raw", R"({"dims":[5,4,3],"type":"int16","spacing":[1e-5,1,10]})"),
+                "too anisotropic");
+  // A clinical stack (0.3 mm pixels, 10 mm slices) is fine.
+  EXPECT_NO_THROW((void)readVolume(
+      sidecar("mr.raw", R"({"dims":[5,4,3],"type":"int16","spacing":[0.3,0.3,10]})"),
+      Precision::FP32));
   expectReadBad(
       sidecar("shear.raw", R"({"dims":[5,4,3],"type":"int16","direction":[1,0.5,0,0,1,0,0,0,1]})"),
       "orthonormal");

@@ -1,4 +1,5 @@
 // checkHeader(): everything that can be refused from a header alone, before any allocation.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -11,6 +12,12 @@
 namespace visopt::io {
 
 namespace {
+
+// Bounds of the geometry checkHeader accepts (world units, usually mm): far beyond any scanner
+// (a micro-CT voxel is ~1e-3 mm, a planet ~1e10 mm) and well inside fp32.
+constexpr double kMinSpacing = 1e-9;
+constexpr double kMaxWorldExtent = 1e15;
+constexpr double kMaxSpacingRatio = 1e4;  // clinical stacks reach ~30 (0.3 mm pixels, 10 mm slices)
 
 std::string dimsText(const std::array<int64_t, 3>& d) {
   return std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " + std::to_string(d[2]);
@@ -66,6 +73,31 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
     }
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(h.origin[a])) throwBadInput(path, "invalid origin (not finite)");
+  // Geometry the renderer and the optimiser can work with in fp32: world positions, their
+  // squares and their differences stay finite and distinct (a spacing of 1e30 or an origin of
+  // -3e38 made the camera infinite, 1e-30 made every distance 0), and the ray-march step, a
+  // fraction of the smallest spacing, crosses the largest axis in a bounded number of steps.
+  double smallest = h.spacing[0], largest = h.spacing[0];
+  for (int a = 0; a < 3; ++a) {
+    smallest = std::min(smallest, h.spacing[a]);
+    largest = std::max(largest, h.spacing[a]);
+    const double extent = h.spacing[a] * double(h.dims[a]);
+    if (!(h.spacing[a] >= kMinSpacing && std::abs(h.origin[a]) + extent <= kMaxWorldExtent)) {
+      std::ostringstream s;
+      s << "spacing " << h.spacing[0] << " x " << h.spacing[1] << " x " << h.spacing[2]
+        << " with origin " << h.origin[0] << ", " << h.origin[1] << ", " << h.origin[2]
+        << " is out of range (spacing >= " << kMinSpacing << ", origin and extent within "
+        << kMaxWorldExtent << " world units)";
+      throwBadInput(path, s.str());
+    }
+  }
+  if (largest / smallest > kMaxSpacingRatio) {
+    std::ostringstream s;
+    s << "spacing " << h.spacing[0] << " x " << h.spacing[1] << " x " << h.spacing[2]
+      << " is too anisotropic (the largest more than " << kMaxSpacingRatio
+      << " times the smallest)";
+    throwBadInput(path, s.str());
+  }
   // Orientation: columns must be finite unit vectors, mutually orthogonal.
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r)

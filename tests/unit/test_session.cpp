@@ -1,10 +1,13 @@
 // Sessions never lose work: exact round trips (JSON and rendered image), migration of older
 // versions, clear errors for damaged files, data found after a move and reported when missing,
 // the world mask stored exactly, atomic saves that survive a crash mid-save, and the CLI.
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -462,13 +465,30 @@ TEST(Session, CrashMidSaveLeavesThePreviousFileIntact) {
   EXPECT_THROW(saveSession(second, path), Error);
   setSessionSaveHook(nullptr);
   EXPECT_EQ(readText(path), before);
-  for (const auto& entry : fs::directory_iterator(dir)) {
-    const std::string name = entry.path().filename().string();
-    if (name.find(".tmp-") != std::string::npos)
-      fs::remove(entry.path());  // the crashes' leftovers
-  }
+
+  // The killed saves left temporaries behind; the next save to the same path removes them (no
+  // process holds their lock), but not one whose writer is still at work (it holds the lock).
+  const fs::path live = dir / ".s.json.tmp-LIVE00";
+  { std::ofstream(live) << "in progress"; }
+  const int liveFd = ::open(live.c_str(), O_RDONLY);
+  ASSERT_GE(liveFd, 0);
+  ASSERT_EQ(::flock(liveFd, LOCK_EX), 0);
+  int leftovers = 0;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos) {
+      // Older than the few seconds during which a fresh temporary is never touched.
+      fs::last_write_time(entry.path(), fs::file_time_type::clock::now() - std::chrono::minutes(1));
+      ++leftovers;
+    }
+  EXPECT_GE(leftovers, 3) << "the two killed mid-write saves' temporaries, and the live one";
   saveSession(second, path);
   EXPECT_EQ(sessionToJson(loadSession(path)), sessionToJson(second));
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos)
+      left.push_back(entry.path().filename().string());
+  EXPECT_EQ(left, std::vector<std::string>{live.filename().string()});
+  ::close(liveFd);
 }
 
 TEST(Session, CliRendersASessionAndDescribesIt) {

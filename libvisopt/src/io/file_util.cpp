@@ -1,5 +1,7 @@
 #include "io/file_util.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -8,13 +10,16 @@
 #include <bit>
 #include <cctype>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "visopt/error.h"
@@ -190,8 +195,46 @@ void checkOutputTarget(const std::string& path) {
   }
 }
 
+namespace {
+
+// The open, flock'ed descriptor of each temporary this process is writing (removeStaleTemporaries).
+std::mutex heldMutex;
+std::map<std::string, int>& heldTemporaries() {
+  static std::map<std::string, int> held;
+  return held;
+}
+
+void release(const std::string& temporary) noexcept {
+  std::lock_guard lock(heldMutex);
+  auto& held = heldTemporaries();
+  auto it = held.find(temporary);
+  if (it == held.end()) return;
+  ::close(it->second);
+  held.erase(it);
+}
+
+}  // namespace
+
+void removeStaleTemporaries(const std::string& dir, const std::string& prefix) noexcept {
+  std::error_code ec;
+  fs::directory_iterator it(dir.empty() ? "." : dir, ec);
+  if (ec) return;
+  const auto now = fs::file_time_type::clock::now();
+  for (const fs::directory_entry& entry : it) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0 || !entry.is_regular_file(ec)) continue;
+    const auto written = entry.last_write_time(ec);
+    if (ec || now - written < std::chrono::seconds(5)) continue;  // maybe being created now
+    const int fd = ::open(entry.path().c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) continue;
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) ::unlink(entry.path().c_str());  // no owner left
+    ::close(fd);
+  }
+}
+
 std::string makeTemporarySibling(const std::string& path, const std::string& suffix) {
   checkOutputTarget(path);
+  removeStaleTemporaries(parentDir(path), fileName(path) + ".tmp-");
   std::string pattern = path + ".tmp-XXXXXX" + suffix;
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
@@ -203,7 +246,10 @@ std::string makeTemporarySibling(const std::string& path, const std::string& suf
   const mode_t mask = ::umask(0);
   ::umask(mask);
   ::fchmod(fd, 0666 & ~mask);
-  ::close(fd);
+  // Held until commit or discard: the lock tells removeStaleTemporaries that it has an owner.
+  ::flock(fd, LOCK_EX);
+  std::lock_guard lock(heldMutex);
+  heldTemporaries()[std::string(name.data())] = fd;
   return std::string(name.data());
 }
 
@@ -214,10 +260,12 @@ void commitTemporary(const std::string& temporary, const std::string& path) {
     throw Error(ErrorKind::Failure,
                 path + ": cannot move the written file into place: " + std::strerror(err));
   }
+  release(temporary);
 }
 
 void discardTemporary(const std::string& temporary) noexcept {
   std::remove(temporary.c_str());
+  release(temporary);
 }
 
 }  // namespace visopt::io

@@ -51,4 +51,12 @@ void checkOutputTarget(const std::string& path);
 void commitTemporary(const std::string& temporary, const std::string& path);
 void discardTemporary(const std::string& temporary) noexcept;
 
+// Temporaries left by a writer that was killed mid-write: every writer holds an exclusive flock
+// on its temporary until it commits or discards it, so one whose lock can be taken (and that is
+// older than a few seconds, so not one being created right now) has no owner and is removed.
+// makeTemporarySibling and saveSession call this for their target before they write, so an
+// interrupted save leaves nothing behind past the next save to the same path.
+// `prefix` is the start of the temporaries' names in `dir` (e.g. "out.png.tmp-").
+void removeStaleTemporaries(const std::string& dir, const std::string& prefix) noexcept;
+
 }  // namespace visopt::io

@@ -2,6 +2,7 @@
 // which is fsynced and renamed over the target (and the folder fsynced), so a crash at any point
 // leaves either the old file or the new one, never a mix.
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <iterator>
 #include <vector>
 
+#include "io/file_util.h"
 #include "visopt/error.h"
 #include "visopt/session.h"
 
@@ -58,10 +60,12 @@ void writeAll(int fd, const char* data, size_t size, const std::string& path) {
 struct Temporary {
   std::string path;
   int fd = -1;
+  int lockFd = -1;  // a duplicate holding the flock until the rename (io::removeStaleTemporaries)
   bool committed = false;
   ~Temporary() {
     if (fd >= 0) ::close(fd);
     if (!committed && !path.empty()) ::unlink(path.c_str());
+    if (lockFd >= 0) ::close(lockFd);
   }
 };
 
@@ -82,13 +86,18 @@ void saveSession(const Session& session, const std::string& path) {
   Temporary tmp;
   std::string hidden = target.filename().string();
   hidden.insert(hidden.begin(), '.');
-  hidden.append(".tmp-XXXXXX");
+  hidden.append(".tmp-");
+  // Temporaries of saves that were killed mid-write (no process holds their lock any more).
+  io::removeStaleTemporaries(dir.string(), hidden);
+  hidden.append("XXXXXX");
   std::string pattern = (dir / hidden).string();
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   tmp.fd = ::mkstemp(name.data());
   if (tmp.fd < 0) failWrite(path, "cannot create a temporary file next to it", errno);
   tmp.path = name.data();
+  ::flock(tmp.fd, LOCK_EX);
+  tmp.lockFd = ::dup(tmp.fd);
   // Keep the permissions of the file being replaced; a new one gets rw-r--r--.
   struct stat old {};
   ::fchmod(tmp.fd, ::stat(target.c_str(), &old) == 0 ? (old.st_mode & 07777) : 0644);

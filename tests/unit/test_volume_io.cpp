@@ -1051,3 +1051,18 @@ TEST(VolumeIoRealData, Water) {
   EXPECT_EQ(raw.grid.dims, plt.grid.dims);
   EXPECT_DOUBLE_EQ(raw.valueMax, plt.valueMax);
 }
+
+// Files that crashed a reader when mutated from valid ones (tests/regression/volumes, each named
+// for what is wrong in it): each is refused as bad input naming the file, by probeVolume (what
+// `visopt info` runs) and by readVolume. vtkNIFTIImageReader segfaulted on a datatype it does not
+// know with bitpix 0 before the NIfTI header was checked ahead of it.
+TEST(VolumeIoRegression, FuzzFindingsAreRefusedCleanly) {
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(VISOPT_REGRESSION_DIR) / "volumes")) {
+    const std::string path = entry.path().string();
+    expectBadInput([&] { (void)probeVolume(path); }, path, "");
+    expectReadBad(path, "");
+    ++files;
+  }
+  EXPECT_GE(files, 2);
+}

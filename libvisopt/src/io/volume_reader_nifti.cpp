@@ -4,7 +4,12 @@
 // factored out, slices reordered when qfac = -1), so world = M * (origin + ijk * spacing); any
 // scale left in the matrix columns is folded into the spacing. The world frame stays NIfTI's RAS.
 // scl_slope / scl_inter are applied to the values.
+#include <zlib.h>
+
 #include <cmath>
+#include <cstring>
+#include <fstream>
+#include <string>
 
 #include <vtkImageData.h>
 #include <vtkMatrix4x4.h>
@@ -18,8 +23,89 @@
 
 namespace visopt::io {
 
+namespace {
+
+// The header fields vtkNIFTIImageReader trusts, checked before it sees the file: a datatype it
+// does not know with bitpix 0, or a dim it multiplies without bounds, crashed it (mutants of a
+// valid file, issue 13). NIfTI-1 (348-byte header) and NIfTI-2 (540), either byte order; .nii.gz
+// is inflated as far as the header. Returns nothing; throws BadInput naming the field.
+template <class T>
+T field(const unsigned char* h, size_t offset, bool swap) {
+  T v;
+  std::memcpy(&v, h + offset, sizeof v);
+  if (swap) swapBytesInPlace(&v, 1, sizeof v);
+  return v;
+}
+
+void checkNiftiHeader(const std::string& path, uint64_t fileSize) {
+  unsigned char h[540] = {};
+  const bool gz = endsWithNoCase(path, ".gz");
+  size_t got = 0;
+  if (gz) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    if (!f) throwBadInput(path, "cannot open");
+    const int n = gzread(f, h, sizeof h);
+    gzclose(f);
+    got = n > 0 ? size_t(n) : 0;
+  } else {
+    std::ifstream in(path, std::ios::binary);
+    in.read(reinterpret_cast<char*>(h), sizeof h);
+    got = size_t(in.gcount());
+  }
+  if (got < 348) throwBadInput(path, "truncated: shorter than a NIfTI header (348 bytes)");
+  int32_t size = field<int32_t>(h, 0, false);
+  const bool swap = size != 348 && size != 540;
+  if (swap) size = field<int32_t>(h, 0, true);
+  if (size != 348 && size != 540) throwBadInput(path, "not a NIfTI file (bad header size)");
+  const bool two = size == 540;
+  if (two && got < 540) throwBadInput(path, "truncated: shorter than a NIfTI-2 header");
+  const int16_t datatype = field<int16_t>(h, two ? 12 : 70, swap);
+  const int16_t bitpix = field<int16_t>(h, two ? 14 : 72, swap);
+  struct Known {
+    int16_t type, bits;
+  };
+  static const Known known[] = {{2, 8},   {4, 16},  {8, 32},   {16, 32},
+                                {64, 64}, {256, 8}, {512, 16}, {768, 32}};
+  bool supported = false;
+  for (const Known& k : known) supported = supported || (k.type == datatype && k.bits == bitpix);
+  if (!supported)
+    throwBadInput(path, "unsupported NIfTI datatype " + std::to_string(datatype) + " with " +
+                            std::to_string(bitpix) +
+                            " bits per value (need one scalar of "
+                            "8, 16, 32 or 64 bits)");
+  int64_t dims[8];
+  for (int d = 0; d < 8; ++d)
+    dims[d] = two ? field<int64_t>(h, 16 + 8 * size_t(d), swap)
+                  : int64_t(field<int16_t>(h, 40 + 2 * size_t(d), swap));
+  if (dims[0] < 1 || dims[0] > 7)
+    throwBadInput(path, "invalid NIfTI dim[0] " + std::to_string(dims[0]) + " (must be 1..7)");
+  double bytes = double(bitpix) / 8.0;
+  for (int d = 1; d <= dims[0]; ++d) {
+    if (dims[d] < 1)
+      throwBadInput(path, "invalid NIfTI dim[" + std::to_string(d) + "] " +
+                              std::to_string(dims[d]) + " (each must be >= 1)");
+    bytes *= double(dims[d]);
+  }
+  const double offset =
+      two ? double(field<int64_t>(h, 168, swap)) : double(field<float>(h, 108, swap));
+  if (!(offset >= double(size)) || !std::isfinite(offset))
+    throwBadInput(path, "invalid NIfTI vox_offset (must lie after the header)");
+  for (int d = 1; d <= 3; ++d) {
+    const double pixdim = two ? field<double>(h, 104 + 8 * size_t(d), swap)
+                              : field<float>(h, 76 + 4 * size_t(d), swap);
+    if (!std::isfinite(pixdim)) throwBadInput(path, "invalid NIfTI pixdim (not finite)");
+  }
+  // The data must be in the file (compressed: checked while inflating, by the reader).
+  if (!gz && offset + bytes > double(fileSize))
+    throwBadInput(path, "truncated: the header describes " + std::to_string(uint64_t(bytes)) +
+                            " bytes of data after offset " + std::to_string(uint64_t(offset)) +
+                            ", the file has " + std::to_string(fileSize) + " bytes");
+}
+
+}  // namespace
+
 LoadedVolume readNifti(const std::string& path, const ProgressCallback& progress) {
-  checkedFileSize(path);
+  checkNiftiHeader(path, checkedFileSize(path));
   vtkNew<vtkNIFTIImageReader> reader;
   {
     VtkErrorCapture capture(reader);

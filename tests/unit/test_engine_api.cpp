@@ -258,6 +258,20 @@ TEST(EngineApi, CamerasLightsStepsAndLevelSetSettingsOutOfRangeAreRefused) {
   }
   rs.stepFactor = kMinStepFactor;
   EXPECT_EQ(e.render(rs).width, 8);
+  // Render settings a session may carry: a light grid of 65536 rays per side asked for 640 GiB
+  // (a failure to allocate, exit 3, instead of a usage error).
+  RenderSettings bad = rs;
+  bad.lightGridSize = 65536;
+  EXPECT_TRUE(refused([&] { e.render(bad); }, "light grid"));
+  bad = rs;
+  bad.previewFactor = 0;
+  EXPECT_TRUE(refused([&] { e.render(bad); }, "preview factor"));
+  bad = rs;
+  bad.exposure = nan;
+  EXPECT_TRUE(refused([&] { e.render(bad); }, "exposure"));
+  bad = rs;
+  bad.earlyStop = 1.f;
+  EXPECT_TRUE(refused([&] { e.render(bad); }, "early stop"));
 
   const LevelSetSettings before = e.levelSetSettings();
   LevelSetSettings ls = before;

@@ -741,3 +741,31 @@ TEST(MeshSdfData, HeadIsOpenAndOnlyAShell) {
   for (size_t i = 0; i < vertices.size(); i += 3)
     ASSERT_NEAR(sampleAt(shell, vertices[i]), -o.shellThickness, voxel) << "vertex " << i;
 }
+
+// PLY mutants that crashed or hung OpenMesh's reader (tests/regression/meshes, named for the
+// damage and what it did): the header is checked line by line first, and each is refused as bad
+// input naming the file (a hang would run into ctest's timeout). A valid PLY still loads.
+TEST(MeshRegression, MalformedPlyHeadersAreRefusedBeforeOpenMeshParsesThem) {
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           std::filesystem::path(VISOPT_REGRESSION_DIR) / "meshes")) {
+    const std::string path = entry.path().string();
+    std::string message;
+    EXPECT_EQ(errorKindOf([&] { sdfFromMesh(path, filledOptions(0.1f), Precision::FP32, nullptr); },
+                          &message),
+              ErrorKind::BadInput)
+        << path;
+    EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+    EXPECT_NE(message.find("PLY"), std::string::npos) << message;
+    ++files;
+  }
+  EXPECT_GE(files, 5);
+  const std::string good = tmp("octahedron.ply");
+  std::ofstream(good) << "ply\nformat ascii 1.0\ncomment an octahedron\nelement vertex 6\n"
+                         "property float x\nproperty float y\nproperty float z\nelement face 8\n"
+                         "property list uchar int vertex_indices\nend_header\n"
+                         "1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n"
+                         "3 0 2 4\n3 2 1 4\n3 1 3 4\n3 3 0 4\n3 2 0 5\n3 1 2 5\n3 3 1 5\n3 0 3 5\n";
+  EXPECT_EQ(sdfFromMesh(good, filledOptions(0.1f), Precision::FP32, nullptr).grid().dims.x > 0,
+            true);
+}

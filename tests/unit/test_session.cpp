@@ -341,6 +341,12 @@ TEST(Session, DamagedFilesGiveOneLineBadInputAndLeaveTheEngineUsable) {
   check("newer.json", R"({"format":"visopt-session","version":99,"data":{"builtin":"x"}})",
         "newer than this visopt");
   check("nodata.json", R"({"format":"visopt-session","version":3})", "missing \"data\"");
+  // A number beyond double: nlohmann reports it as out_of_range, which went out as an anonymous
+  // failure (exit 3) without the file's name.
+  check(
+      "overflow.json",
+      R"({"format":"visopt-session","version":3,"data":{"builtin":"a"},"extinction":{"q":1e999}})",
+      "invalid JSON");
   check("badtype.json",
         R"({"format":"visopt-session","version":3,"data":{"builtin":"a"},"extinction":{"q":"x"}})",
         "extinction.q: expected a number");

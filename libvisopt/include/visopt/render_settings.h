@@ -50,8 +50,8 @@ struct RenderSettings {
 
   // Light-space frustum grid for T_L (paper 000 Eq. 5): rays per side, depth cells (0 = one per
   // voxel along the volume's diagonal).
-  int lightGridSize = 192;
-  int lightGridDepth = 0;
+  int lightGridSize = 192;  // kMinLightGridSize..kMaxLightGridSize
+  int lightGridDepth = 0;   // 0..kMaxLightGridDepth
   // Stop marching once the view transmittance drops below this.
   float earlyStop = 1e-4f;
 
@@ -73,6 +73,13 @@ struct RenderSettings {
   float importanceOverlay = 0.f;
   bool worldMaskOverlay = false;
 };
+
+inline constexpr int kMinLightGridSize = 16, kMaxLightGridSize = 1024, kMaxLightGridDepth = 4096;
+
+// Throws Error(Usage) naming the setting unless every value is in the range stated next to it
+// (finite, non-negative weights; the step, the image and light-grid sizes in their ranges).
+// Engine::render checks before it allocates anything.
+void checkRenderSettings(const RenderSettings& settings);
 
 struct RenderStats {
   double milliseconds = 0.0;

@@ -283,6 +283,7 @@ const PointLight& Engine::light() const {
 Image Engine::render(const RenderSettings& settings, RenderStats* stats,
                      const std::function<bool()>& abandon) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
+  checkRenderSettings(settings);  // before the light grid or the image is allocated
   // A camera or light set before the volume (or one a session carried) meets its bounds here.
   const Bounds bounds = impl_->volume->grid().worldBounds();
   checkCamera(impl_->camera, bounds);

@@ -141,16 +141,7 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
 Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,
                   const std::function<bool()>& abandon) {
   if (!scene.volume || !scene.transfer) throw Error(ErrorKind::Usage, "nothing to render");
-  if (settings.width <= 0 || settings.height <= 0 || settings.width > 16384 ||
-      settings.height > 16384)
-    throw Error(ErrorKind::Usage, "image size must be between 1 and 16384 pixels per side");
-  if (!(settings.stepFactor >= kMinStepFactor && settings.stepFactor <= kMaxStepFactor)) {
-    char message[128];
-    std::snprintf(message, sizeof message,
-                  "the ray-march step must be %g..%g times the smallest voxel spacing",
-                  double(kMinStepFactor), double(kMaxStepFactor));
-    throw Error(ErrorKind::Usage, message);
-  }
+  checkRenderSettings(settings);
   const auto start = std::chrono::steady_clock::now();
   const bool preview = settings.preview && settings.previewFactor > 1;
   const int w = preview ? std::max(1, settings.width / settings.previewFactor) : settings.width;

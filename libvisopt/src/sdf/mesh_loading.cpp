@@ -193,6 +193,91 @@ void validateStl(const std::string& path, uint64_t size) {
                           std::to_string(size));
 }
 
+// The PLY header, checked line by line before OpenMesh parses it: OpenMesh's reader looped
+// without end on a header without "end_header" and crashed on malformed element or property
+// lines (mutants of a valid file, issue 13). Accepted: "ply", a format line (ascii or binary,
+// version 1.0), comment/obj_info lines, "element NAME COUNT" and "property [list T] T NAME"
+// with PLY's scalar types, then "end_header" within the first 1000 lines; a vertex element with
+// x, y and z and a face element with a vertex_indices list; counts the file's bytes can hold.
+void validatePlyHeader(const std::string& path, uint64_t size) {
+  static const char* const scalarTypes[] = {
+      "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+      "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  auto isScalar = [](const std::string& t) {
+    for (const char* s : scalarTypes)
+      if (t == s) return true;
+    return false;
+  };
+  // A header line for a one-line message: at most 60 characters, non-printable bytes as '?'.
+  auto shown = [](const std::string& text) {
+    std::string out = text.substr(0, 60);
+    for (char& ch : out)
+      if (static_cast<unsigned char>(ch) < 32 || static_cast<unsigned char>(ch) > 126) ch = '?';
+    return out;
+  };
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  auto next = [&]() {
+    if (!std::getline(in, line)) return false;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  if (!next() || line != "ply") throwBadInput(path, "not a PLY file (no \"ply\" line)");
+  if (!next() || (line != "format ascii 1.0" && line != "format binary_little_endian 1.0" &&
+                  line != "format binary_big_endian 1.0"))
+    throwBadInput(
+        path, "malformed PLY header: expected a format line, got \"" + line.substr(0, 60) + "\"");
+  std::string element;
+  long long vertices = -1, faces = -1;
+  bool x = false, y = false, z = false, indices = false, ended = false;
+  for (int n = 0; n < 1000 && next(); ++n) {
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (word == "end_header") {
+      ended = true;
+      break;
+    }
+    if (word == "comment" || word == "obj_info") continue;
+    auto bad = [&] {
+      throwBadInput(
+          path, "malformed PLY header line " + std::to_string(n + 3) + ": \"" + shown(line) + "\"");
+    };
+    std::string a, b, c, rest;
+    if (word == "element") {
+      long long count = -1;
+      if (!(words >> element >> count) || (words >> rest) || count < 0) bad();
+      // Every element takes at least a byte per entry (ascii: a digit and a separator).
+      if (uint64_t(count) > size) bad();
+      if (element == "vertex") vertices = count;
+      if (element == "face") faces = count;
+    } else if (word == "property") {
+      if (element.empty() || !(words >> a)) bad();
+      if (a == "list") {
+        if (!(words >> b >> c >> rest) || !isScalar(b) || !isScalar(c) || b == "float" ||
+            b == "double" || b == "float32" || b == "float64")
+          bad();
+        if (element == "face" && (rest == "vertex_indices" || rest == "vertex_index"))
+          indices = true;
+      } else {
+        if (!isScalar(a) || !(words >> b) || (words >> rest)) bad();
+        if (element == "vertex") {
+          x = x || b == "x";
+          y = y || b == "y";
+          z = z || b == "z";
+        }
+      }
+    } else {
+      bad();
+    }
+  }
+  if (!ended) throwBadInput(path, "malformed or truncated PLY header: no end_header line");
+  if (vertices < 0 || !(x && y && z))
+    throwBadInput(path, "the PLY file has no vertex element with x, y and z");
+  if (faces < 0 || !indices)
+    throwBadInput(path, "the PLY file has no face element with a vertex_indices list");
+}
+
 // "element vertex N" / "element face M" from a PLY header (-1 when absent).
 void plyCounts(const std::string& path, long long& vertices, long long& faces) {
   vertices = faces = -1;
@@ -364,6 +449,7 @@ TriangleMesh loadMesh(const std::string& path, MeshReport& report, const Progres
     throwBadInput(path, "unsupported mesh format (expected .obj, .ply, .off or .stl)");
   if (off) validateAsciiOff(path);
   if (stl) validateStl(path, size);
+  if (ply) validatePlyHeader(path, size);
 
   PolyMesh polyMesh;
   polyMesh.request_vertex_status();

@@ -267,7 +267,7 @@ Session sessionFromJson(const std::string& text, const std::string& origin) {
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse errors, and numbers beyond double (1e999)
     std::string msg = e.what();
     if (auto close = msg.find("] ");
         !msg.empty() && msg.front() == '[' && close != std::string::npos)

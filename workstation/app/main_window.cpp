@@ -69,7 +69,9 @@ MainWindow::MainWindow(Precision precision, const QString& stateDir, QWidget* pa
   connectController();
 
   statusLabel_ = new QLabel(this);
-  statusBar()->addPermanentWidget(statusLabel_, 1);
+  // No stretch: with one, the label took the whole bar and hid every temporary message
+  // (errors, "Done", a reader's warning) behind it.
+  statusBar()->addPermanentWidget(statusLabel_);
   statusTimer_.setInterval(500);
   connect(&statusTimer_, &QTimer::timeout, this, &MainWindow::updateStatus);
   statusTimer_.start();
@@ -595,9 +597,8 @@ void MainWindow::openVolume(const QString& path) {
         if (!warnings.isEmpty())
           QMetaObject::invokeMethod(
               this,
-              [this, warnings] {
-                statusBar()->showMessage(warnings.join(QStringLiteral("; ")), 30000);
-              },
+              // Shown when the long work ends, in place of its "Done".
+              [this, warnings] { loadWarning_ = warnings.join(QStringLiteral("; ")); },
               Qt::QueuedConnection);
       });
   controller_->restartOptimization();
@@ -726,6 +727,11 @@ void MainWindow::onLongWorkFinished(bool ok) {
   if (progress_) {
     progress_->reset();
     progress_->deleteLater();
+  }
+  if (ok && !loadWarning_.isEmpty()) {
+    statusBar()->showMessage(loadWarning_, 30000);
+    loadWarning_.clear();
+    return;
   }
   statusBar()->showMessage(ok ? tr("Done") : tr("Stopped"), 3000);
 }

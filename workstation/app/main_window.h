@@ -152,6 +152,7 @@ class MainWindow : public QMainWindow {
   std::optional<Camera> cameraBeforeLooking_;
   LocateHook locateHook_;
   bool sceneLoading_ = false;
+  QString loadWarning_;  // a reader's warning for the volume being opened, shown when it is
 
   ViewportWidget* viewport_ = nullptr;
   TransferFunctionEditor* tfEditor_ = nullptr;

@@ -246,7 +246,6 @@ void NarrowBand::rebuildSpans() {
         flags_[size_t(a) - 1] == kActiveBrick && flags_[size_t(a) + 1] == kActiveBrick)
       work[size_t(a)] = 1;
   }
-  workBricks_.clear();
   for (const int32_t a : active_) (work[size_t(a)] ? workBricks_ : idle_).push_back(a);
   appendSpans(work, nb_, dims_, work_);
   appendSpans(dilated(work, nb_), nb_, dims_, workHalo_);

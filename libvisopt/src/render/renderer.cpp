@@ -141,7 +141,7 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
 Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,
                   const std::function<bool()>& abandon) {
   if (!scene.volume || !scene.transfer) throw Error(ErrorKind::Usage, "nothing to render");
-  checkRenderSettings(settings);
+  // The settings were checked by the caller (Engine::render) before it allocated anything.
   const auto start = std::chrono::steady_clock::now();
   const bool preview = settings.preview && settings.previewFactor > 1;
   const int w = preview ? std::max(1, settings.width / settings.previewFactor) : settings.width;

@@ -48,7 +48,8 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
                                Field3D& out);
 
 // `abandon` (may be empty) is polled between bands of the image; when it returns true the render
-// stops and returns an empty (0 x 0) image.
+// stops and returns an empty (0 x 0) image. `settings` must have passed checkRenderSettings
+// (Engine::render checks them before it allocates the light grid).
 Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,
                   const std::function<bool()>& abandon = {});
 

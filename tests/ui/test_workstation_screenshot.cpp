@@ -143,6 +143,11 @@ void TestWorkstationScreenshot::windowScreenshotUnderXvfb() {
   const ColourStats all = colourStats(window32, window32.rect());
   QVERIFY(all.distinct > frame.distinct);
   QVERIFY(region.width() < window.width() && region.height() < window.height());
+  // The 3D view gets most of the window (the panels share one tabbed column).
+  QVERIFY2(region.width() >= int(0.6 * double(window.width())),
+           qPrintable(QStringLiteral("the 3D view is %1 of %2 pixels wide")
+                          .arg(region.width())
+                          .arg(window.width())));
   // Last, so the checks above run regardless: the window has the size asked for (a taller one
   // means the docks' minimum heights do not fit a 1280x800 screen).
   QVERIFY2(window.height() == 800,

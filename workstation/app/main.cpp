@@ -1,5 +1,6 @@
 // visopt-workstation: the Qt application. Without arguments it opens the built-in default scene
-// (or offers to recover a crashed session). Scripting options open a scene, a volume or a
+// (or offers to recover a crashed session); files on the command line open as a user expects
+// (command_line_files.h). Scripting options open a scene, a volume or a
 // session, export a screenshot after the first converged frame and quit, or measure the latency
 // from a camera drag to the preview on screen while the optimisation runs.
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include <visopt/scenes.h>
 
 #include "camera_navigation.h"
+#include "command_line_files.h"
 #include "main_window.h"
 #include "panels/deviation_panel.h"
 #include "viewport_widget.h"
@@ -105,7 +107,21 @@ int main(int argc, char** argv) {
                          QStringLiteral("TITLE"));
   parser.addOptions({scene, volume, session, resolution, screenshot, windowShot, size, noOptimize,
                      latency, stateDir, timeout, saveTo, deviation, tab});
+  parser.addPositionalArgument(
+      QStringLiteral("files"),
+      QStringLiteral("A volume file or DICOM folder, or a session (.visopt-session, .json), to "
+                     "open; meshes (.ply .obj .off .stl) and level sets (.vdb) to add as "
+                     "context surfaces."),
+      QStringLiteral("[FILE...]"));
   parser.process(app);
+
+  const CommandLineFiles files = sortCommandLineFiles(parser.positionalArguments());
+  if (!files.error.isEmpty()) {
+    std::fprintf(stderr, "visopt-workstation: %s\n", files.error.toUtf8().constData());
+    return 2;
+  }
+  const QString volumePath = files.volume.isEmpty() ? parser.value(volume) : files.volume;
+  const QString sessionPath = files.session.isEmpty() ? parser.value(session) : files.session;
 
   const bool scripted = parser.isSet(screenshot) || parser.isSet(windowShot) ||
                         parser.isSet(latency) || parser.isSet(saveTo);
@@ -124,17 +140,20 @@ int main(int argc, char** argv) {
     ++failures;
   });
 
-  const bool recovered = !scripted && !parser.isSet(session) && window.offerRecovery();
-  if (parser.isSet(session)) {
-    if (!window.openSession(parser.value(session)) && scripted) return 1;
-  } else if (parser.isSet(volume)) {
-    window.openVolume(parser.value(volume));
+  const bool recovered =
+      !scripted && sessionPath.isEmpty() && volumePath.isEmpty() && window.offerRecovery();
+  if (!sessionPath.isEmpty()) {
+    if (!window.openSession(sessionPath) && scripted) return 1;
+  } else if (!volumePath.isEmpty()) {
+    window.openVolume(volumePath);
   } else if (!recovered) {
     QString name = parser.value(scene);
     if (name.startsWith(QStringLiteral("builtin:"))) name = name.mid(8);
     if (name.isEmpty()) name = QString::fromStdString(defaultSceneName());
     window.openBuiltinScene(name, parser.value(resolution).toInt());
   }
+
+  for (const QString& source : files.surfaces) window.addContextSurface(source);
 
   if (parser.isSet(deviation)) {
     window.deviationPanel()->setDeviationSettings(true, Colormap::Viridis, 4.f);
@@ -150,8 +169,12 @@ int main(int argc, char** argv) {
   if (!scripted) return app.exec();
 
   const int timeoutMs = parser.value(timeout).toInt() * 1000;
-  if (!window.waitForSettledFrame(timeoutMs)) {
-    std::fprintf(stderr, "visopt-workstation: no converged frame within %d s\n", timeoutMs / 1000);
+  // An error (a file that cannot be read, ...) ends a scripted run at once, with its message
+  // already printed, rather than waiting for a frame that will not come.
+  if (!window.waitForSettledFrame(timeoutMs, [&] { return failures > 0; })) {
+    if (failures == 0)
+      std::fprintf(stderr, "visopt-workstation: no converged frame within %d s\n",
+                   timeoutMs / 1000);
     return 1;
   }
   if (failures > 0) return 1;

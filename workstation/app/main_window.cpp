@@ -1,5 +1,7 @@
 #include "main_window.h"
 
+#include <algorithm>
+
 #include <QAction>
 #include <QActionGroup>
 #include <QApplication>
@@ -9,6 +11,7 @@
 #include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QElapsedTimer>
+#include <QFile>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QInputDialog>
@@ -17,7 +20,9 @@
 #include <QMessageBox>
 #include <QProgressDialog>
 #include <QSaveFile>
+#include <QShowEvent>
 #include <QStatusBar>
+#include <QTabBar>
 #include <QToolBar>
 
 #include <visopt/error.h>
@@ -42,6 +47,8 @@ namespace visopt::ws {
 namespace {
 
 constexpr int kAutosaveIntervalMs = 3 * 60 * 1000;
+// Of the remembered panel layout: raise it when the panels change, so an old layout is ignored.
+constexpr int kLayoutVersion = 2;
 const char* kSessionFilter = "visopt sessions (*.visopt-session *.json);;All files (*)";
 
 QString fromStd(const std::string& s) {
@@ -191,19 +198,20 @@ void MainWindow::buildDocks() {
   tfEditor_->logScaleCheckBox()->setChecked(true);
   importanceEditor_->logScaleCheckBox()->setChecked(true);
 
+  // One column of tabbed panels on the right (tabs on top, where their titles fit), so the 3D
+  // view keeps most of the window (applyDefaultLayout sizes the column); a panel can be dragged
+  // out beside the others, and the arrangement is remembered (saveLayout / restoreLayout).
+  setTabPosition(Qt::RightDockWidgetArea, QTabWidget::North);
+  setDockOptions(dockOptions() | QMainWindow::GroupedDragging);
   auto* dTf = dock(tr("Transfer function"), tfEditor_, Qt::RightDockWidgetArea);
   auto* dImp = dock(tr("Importance"), importanceEditor_, Qt::RightDockWidgetArea);
-  auto* dSurf = dock(tr("Context surfaces"), surfacesPanel_, Qt::RightDockWidgetArea);
-  auto* dOpt = dock(tr("Optimisation"), optimizationPanel_, Qt::LeftDockWidgetArea);
-  auto* dDev = dock(tr("Deviation view"), deviationPanel_, Qt::LeftDockWidgetArea);
+  auto* dSurf = dock(tr("Surfaces"), surfacesPanel_, Qt::RightDockWidgetArea);
+  auto* dOpt = dock(tr("Optimisation"), optimizationPanel_, Qt::RightDockWidgetArea);
+  auto* dDev = dock(tr("Deviation"), deviationPanel_, Qt::RightDockWidgetArea);
   comparisonDock_ = dock(tr("Comparison"), comparisonView_, Qt::BottomDockWidgetArea);
   comparisonDock_->hide();
-  tabifyDockWidget(dTf, dImp);
-  tabifyDockWidget(dImp, dSurf);
-  dTf->raise();
-  tabifyDockWidget(dOpt, dDev);
-  dOpt->raise();
-  resizeDocks({dOpt, dTf}, {300, 380}, Qt::Horizontal);
+  panels_ = {dTf, dImp, dSurf, dOpt, dDev};
+  arrangePanels();
 
   // Editors -> engine.
   connect(tfEditor_, &TransferFunctionEditor::transferFunctionEdited, this,
@@ -242,13 +250,7 @@ void MainWindow::buildDocks() {
 
   connect(surfacesPanel_, &ContextSurfacesPanel::addSurfaceRequested, this,
           [this](const ContextSurfaceSpec& spec) {
-            controller_->postLong(tr("Context surface %1").arg(fromStd(spec.source)),
-                                  [this, spec](Engine& e, const ProgressCallback& progress) {
-                                    e.addContextSurface(spec, progress);
-                                    controller_->refreshSnapshot(e);
-                                  });
-            controller_->restartOptimization();
-            setModified();
+            addSurface(fromStd(spec.source), [spec](const Engine&) { return spec; });
           });
   connect(surfacesPanel_, &ContextSurfacesPanel::removeSurfaceRequested, this, [this](int row) {
     controller_->post(tr("Remove surface"), [this, row](Engine& e) {
@@ -403,6 +405,8 @@ void MainWindow::buildMenus() {
                   &MainWindow::compareMethods);
   view->addSeparator();
   for (QDockWidget* d : findChildren<QDockWidget*>()) view->addAction(d->toggleViewAction());
+  view->addAction(tr("&Reset panel layout"), this, &MainWindow::resetLayout)
+      ->setToolTip(tr("All panels back in one tabbed column on the right"));
 
   QMenu* opt = menuBar()->addMenu(tr("&Optimisation"));
   opt->addAction(actRun_);
@@ -540,11 +544,12 @@ void MainWindow::setOptimizationRunning(bool running) {
   if (optimizationPanel_) optimizationPanel_->setRunning(running);
 }
 
-bool MainWindow::waitForSettledFrame(int timeoutMs) {
+bool MainWindow::waitForSettledFrame(int timeoutMs, const std::function<bool()>& giveUp) {
   QElapsedTimer clock;
   clock.start();
   while (clock.elapsed() < timeoutMs) {
     QApplication::processEvents(QEventLoop::AllEvents, 50);
+    if (giveUp && giveUp()) return false;
     const bool settled = !sceneLoading_ && controller_->waitIdle(20);
     if (settled) {
       // Deliver the frames and signals queued by the worker before it went idle.
@@ -884,8 +889,85 @@ void MainWindow::closeEvent(QCloseEvent* event) {
     event->ignore();
     return;
   }
+  saveLayout();
   files_.markCleanExit();
   event->accept();
+}
+
+void MainWindow::addContextSurface(const QString& source) {
+  addSurface(source, [source](const Engine& e) {
+    return defaultContextSurfaceSpec(source.toStdString(), e.volume().grid());
+  });
+}
+
+void MainWindow::addSurface(const QString& source,
+                            std::function<ContextSurfaceSpec(const Engine&)> specFor) {
+  controller_->postLong(tr("Context surface %1").arg(source),
+                        [this, specFor](Engine& e, const ProgressCallback& progress) {
+                          e.addContextSurface(specFor(e), progress);
+                          controller_->refreshSnapshot(e);
+                        });
+  controller_->restartOptimization();
+  setModified();
+}
+
+// ---- the panel layout -------------------------------------------------------------------------
+
+void MainWindow::arrangePanels() {
+  for (QDockWidget* d : panels_) {
+    d->setFloating(false);
+    addDockWidget(Qt::RightDockWidgetArea, d);
+    d->show();
+  }
+  for (size_t i = 1; i < panels_.size(); ++i) tabifyDockWidget(panels_[i - 1], panels_[i]);
+  panels_.front()->raise();
+  showWholeTabTitles();
+}
+
+void MainWindow::showWholeTabTitles() {
+  // Qt elides the titles of tabbed panels to fit ("Transfer fun..."); whole titles and scroll
+  // arrows where a narrow column cannot hold them all read better. The main window makes its
+  // tab bars as panels are tabbed, so this runs after each arrangement.
+  for (QTabBar* bar : findChildren<QTabBar*>(Qt::FindDirectChildrenOnly)) {
+    bar->setElideMode(Qt::ElideNone);
+    bar->setUsesScrollButtons(true);
+  }
+}
+
+int MainWindow::defaultPanelWidth() const {
+  // About a third of the window, within what the panels' forms need and what leaves the 3D view
+  // at least 60 % of a 1280-pixel window.
+  return std::clamp(int(0.38 * double(width())), 340, 520);
+}
+
+void MainWindow::resetLayout() {
+  comparisonDock_->hide();
+  arrangePanels();
+  resizeDocks({panels_.front()}, {defaultPanelWidth()}, Qt::Horizontal);
+}
+
+void MainWindow::showEvent(QShowEvent* event) {
+  QMainWindow::showEvent(event);
+  if (layoutPlaced_) return;
+  layoutPlaced_ = true;
+  if (!restoreLayout()) resizeDocks({panels_.front()}, {defaultPanelWidth()}, Qt::Horizontal);
+  showWholeTabTitles();
+}
+
+bool MainWindow::restoreLayout() {
+  QFile f(files_.layoutPath());
+  if (!f.open(QIODevice::ReadOnly)) return false;
+  // A layout of another version or a damaged file is ignored: the default layout stands.
+  return restoreState(f.read(1 << 20), kLayoutVersion);
+}
+
+void MainWindow::saveLayout() {
+  if (!layoutPlaced_) return;  // never shown: nothing arranged by the user
+  QSaveFile f(files_.layoutPath());
+  if (f.open(QIODevice::WriteOnly)) {
+    f.write(saveState(kLayoutVersion));
+    f.commit();
+  }
 }
 
 // ---- views ----------------------------------------------------------------------------------

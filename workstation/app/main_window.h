@@ -3,8 +3,10 @@
 // EngineController as a command, and every view of the scene comes back from it.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <QMainWindow>
 #include <QPointer>
@@ -54,6 +56,9 @@ class MainWindow : public QMainWindow {
   // Opening data. Each replaces the scene; errors are reported (dialog / errorShown).
   void openBuiltinScene(const QString& name, int resolution = 128);
   void openVolume(const QString& path);
+  // A context surface from "iso:...", "mesh:FILE" or "vdb:FILE" with the representation it
+  // gets by default (defaultContextSurfaceSpec), added to the scene (after any load in flight).
+  void addContextSurface(const QString& source);
   // A session: false (and a report) when the file cannot be read; the current scene stays.
   bool openSession(const QString& path);
   bool saveSessionTo(const QString& path);
@@ -75,7 +80,8 @@ class MainWindow : public QMainWindow {
   const RenderSettings& renderSettings() const { return render_; }
   // Processes events until the optimisation converged (or is off) and a full-size frame of the
   // current state is shown. False on timeout.
-  bool waitForSettledFrame(int timeoutMs);
+  // False on timeout, or as soon as `giveUp` returns true (a scripted run after an error).
+  bool waitForSettledFrame(int timeoutMs, const std::function<bool()>& giveUp = {});
   bool exportViewport(const QString& pngPath);
 
   EngineController* controller() const { return controller_.get(); }
@@ -103,11 +109,21 @@ class MainWindow : public QMainWindow {
 
  protected:
   void closeEvent(QCloseEvent* event) override;
+  void showEvent(QShowEvent* event) override;
 
  private:
   void buildActions();
   void buildMenus();
   void buildDocks();
+  // The panel layout: every panel tabbed in one column on the right, about a third of the
+  // window wide; remembered in the state folder between runs.
+  void addSurface(const QString& source, std::function<ContextSurfaceSpec(const Engine&)> specFor);
+  void arrangePanels();
+  void showWholeTabTitles();
+  int defaultPanelWidth() const;
+  void resetLayout();
+  bool restoreLayout();
+  void saveLayout();
   void buildToolBar();
   void buildBrushBar();
   void updateBrushRange();
@@ -162,6 +178,8 @@ class MainWindow : public QMainWindow {
   DeviationPanel* deviationPanel_ = nullptr;
   ComparisonView* comparisonView_ = nullptr;
   QDockWidget* comparisonDock_ = nullptr;
+  std::vector<QDockWidget*> panels_;  // the side panels, in tab order
+  bool layoutPlaced_ = false;         // the first show sized or restored the panel layout
   MaskPaintTool* maskTool_ = nullptr;
   LensTool* lensTool_ = nullptr;
   WindowMaskTool* windowTool_ = nullptr;

@@ -24,6 +24,10 @@ QString SessionFiles::autosavePath() const {
   return dir_ + QStringLiteral("/autosave.visopt-session");
 }
 
+QString SessionFiles::layoutPath() const {
+  return dir_ + QStringLiteral("/window-layout.bin");
+}
+
 QString SessionFiles::runningMarkerPath() const {
   return dir_ + QStringLiteral("/running.marker");
 }

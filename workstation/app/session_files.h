@@ -14,6 +14,7 @@ class SessionFiles {
 
   const QString& stateDir() const { return dir_; }
   QString autosavePath() const;
+  QString layoutPath() const;  // the window's panel arrangement (QMainWindow::saveState)
   // The marker exists while the application runs; a marker found at start means the last run
   // ended without a clean exit (a crash), so its autosave is offered for recovery.
   QString runningMarkerPath() const;

@@ -1,0 +1,36 @@
+#include "command_line_files.h"
+
+#include <QFileInfo>
+
+namespace visopt::ws {
+
+CommandLineFiles sortCommandLineFiles(const QStringList& paths) {
+  CommandLineFiles files;
+  QString scene;  // the first volume or session, for the message when another follows
+  for (const QString& path : paths) {
+    const QString suffix = QFileInfo(path).suffix().toLower();
+    const bool isDir = QFileInfo(path).isDir();
+    if (!isDir && (suffix == QLatin1String("ply") || suffix == QLatin1String("obj") ||
+                   suffix == QLatin1String("off") || suffix == QLatin1String("stl"))) {
+      files.surfaces << QStringLiteral("mesh:") + path;
+      continue;
+    }
+    if (!isDir && suffix == QLatin1String("vdb")) {
+      files.surfaces << QStringLiteral("vdb:") + path;
+      continue;
+    }
+    if (!scene.isEmpty()) {
+      files.error = QStringLiteral("%1: only one volume or session opens at a time (%2 is open)")
+                        .arg(path, scene);
+      return files;
+    }
+    scene = path;
+    if (!isDir && (suffix == QLatin1String("visopt-session") || suffix == QLatin1String("json")))
+      files.session = path;
+    else
+      files.volume = path;
+  }
+  return files;
+}
+
+}  // namespace visopt::ws

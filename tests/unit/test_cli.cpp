@@ -1,11 +1,13 @@
 // The visopt command-line tool as a script would use it: exit codes (0 ok, 1 usage, 2 bad input,
 // 3 other), one JSON object on stdout with --json, one-line errors naming the file.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -15,6 +17,9 @@
 
 #include "cli_runner.h"
 #include "visopt/image.h"
+#include "visopt/level_set.h"
+#include "visopt/optimization.h"
+#include "visopt/render_settings.h"
 
 namespace fs = std::filesystem;
 
@@ -262,4 +267,48 @@ TEST(Cli, DevicesPipesAndFoldersAreRefused) {
   EXPECT_EQ(r.err.find("level 0"), std::string::npos) << "refused before optimising";
   EXPECT_TRUE(std::filesystem::is_fifo(fifo));
   std::filesystem::remove(fifo);
+}
+
+// The help of each option shows its default, and for the optimisation's settings that default is
+// the library's own (the CLI once said "default 6" for a band of 8).
+TEST(Cli, HelpShowsTheLibrarysDefaults) {
+  const Result r = run("optimize --help");
+  ASSERT_EQ(r.code, 0) << r.err;
+  // "  --lambda FLOAT=0.3   How strongly ..." -> 0.3
+  auto shown = [&](const std::string& option) -> double {
+    const size_t at = r.out.find("  " + option + " ");
+    if (at == std::string::npos) return std::nan("");
+    const size_t eq = r.out.find('=', at);
+    const size_t eol = r.out.find('\n', at);
+    if (eq == std::string::npos || eq > eol) return std::nan("");
+    return std::strtod(r.out.c_str() + eq + 1, nullptr);
+  };
+  const visopt::ExtinctionSettings e;
+  const visopt::LevelSetSettings ls;
+  const std::pair<const char*, double> expected[] = {
+      {"--lambda", ls.lambda},
+      {"--level-set-reach", ls.reach},
+      {"--level-set-band", ls.band},
+      {"--redist-iterations", ls.redistanceIterations},
+      {"--rho", e.rho},
+      {"--q", e.q},
+      {"--r", e.r},
+      {"--lr", e.learningRate},
+      {"--mu-max", e.muMax},
+      {"--levels", e.levels},
+      {"--iterations", e.maxIterationsPerLevel},
+      {"--tolerance", e.tolerance},
+      {"--frustum-scale", e.frustumScale}};
+  for (const auto& [option, value] : expected)
+    EXPECT_NEAR(shown(option), value, 1e-6 * std::max(1.0, std::abs(value))) << option << "\n"
+                                                                             << r.out;
+  EXPECT_NE(r.out.find("--size TEXT=512x512"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--camera TEXT=the scene's view"), std::string::npos) << r.out;
+
+  const Result render = run("render --help");
+  ASSERT_EQ(render.code, 0);
+  const size_t step = render.out.find("--step FLOAT=");
+  ASSERT_NE(step, std::string::npos) << render.out;
+  EXPECT_FLOAT_EQ(std::strtof(render.out.c_str() + step + 13, nullptr),
+                  visopt::RenderSettings{}.stepFactor);
 }

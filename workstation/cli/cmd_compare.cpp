@@ -21,10 +21,12 @@ Runner addCompareCommand(CLI::App& app) {
   app.add_option("--volume", o->volume, "Volume file or DICOM folder");
   app.add_option("--scene", o->scene, "Built-in scene, builtin:NAME");
   app.add_option("--resolution", o->resolution, "Built-in scene resolution");
-  app.add_option("--tf", o->tf, "Transfer function: JSON file or preset:NAME");
+  app.add_option("--tf", o->tf, "Transfer function: JSON file or preset:NAME")
+      ->default_str("the scene's own; preset:generic for a volume");
   app.add_option("--importance", o->importance, "Importance curve JSON or volume");
-  app.add_option("--context", o->contexts, "Context surface (repeatable), as for optimize");
-  app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST");
+  app.add_option("--context", o->contexts, "Context surface (repeatable), as for optimize")
+      ->default_str("");
+  app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST")->default_str("the scene's view");
   app.add_option("--size", o->size, "Size WxH of each of the four images");
   app.add_option("--iterations", o->iterations, "Iteration cap per level for ours");
   app.add_option("--levels", o->levels, "Multigrid levels for ours");

@@ -62,38 +62,47 @@ std::string beforePath(const std::string& out) {
 }  // namespace
 
 Runner addOptimizeCommand(CLI::App& app) {
+  // The library's defaults, which the help shows (main.cpp: always_capture_default), so that
+  // the two cannot drift apart.
+  static const ExtinctionSettings kExtinction{};
+  static const LevelSetSettings kLevelSet{};
   struct Options {
     std::string volume, scene, tf, importance, camera, light, viewFrom,
         size = "512x512", precision = "fp32", optimizer = "ademamix", out, worldMask, lens,
         deviationColormap = "viridis";
     std::vector<std::string> contexts;
-    float shell = -1.f, lambda = -1.f;
-    int redistIterations = -1;
-    float reach = -1.f;
-    float band = -1.f;
+    float shell = 0.f, lambda = kLevelSet.lambda;
+    int redistIterations = kLevelSet.redistanceIterations;
+    float reach = kLevelSet.reach;
+    float band = kLevelSet.band;
     bool filled = false, deviationView = false;
-    int resolution = 128, levels = 3, iterations = 60;
-    float rho = -1.f, q = 40.f, r = 0.f, lr = 0.05f, muMax = 0.f, frustumScale = 0.5f,
-          tolerance = 1e-4f;
+    int resolution = 128, levels = kExtinction.levels,
+        iterations = kExtinction.maxIterationsPerLevel;
+    float rho = kExtinction.rho, q = kExtinction.q, r = kExtinction.r,
+          lr = kExtinction.learningRate, muMax = kExtinction.muMax,
+          frustumScale = kExtinction.frustumScale, tolerance = kExtinction.tolerance;
     bool json = false, quiet = false;
   };
   auto o = std::make_shared<Options>();
   app.add_option("--volume", o->volume, "Volume file or DICOM folder");
   app.add_option("--scene", o->scene, "Built-in scene, builtin:NAME (carries its own importance)");
   app.add_option("--resolution", o->resolution, "Built-in scene resolution (longest axis, voxels)");
-  app.add_option("--tf", o->tf, "Transfer function: JSON file (visopt or ParaView) or preset:NAME");
+  app.add_option("--tf", o->tf, "Transfer function: JSON file (visopt or ParaView) or preset:NAME")
+      ->default_str("the scene's own; preset:generic for a volume");
   app.add_option("--importance", o->importance,
                  "Importance g in [0,1]: preset:NAME (the importance a transfer-function preset "
                  "is made for, the default with --tf preset:ct-skin-bone or preset:ct-bone: "
                  "bone), a curve JSON {\"points\":[[value,g],...]} or a volume file on the same "
                  "grid");
-  app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST (degrees, degrees, bounding radii)");
-  app.add_option("--light", o->light, "Point light on an orbit AZ,EL,DIST (default: key light)");
+  app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST (degrees, degrees, bounding radii)")
+      ->default_str("the scene's view");
+  app.add_option("--light", o->light, "Point light on an orbit AZ,EL,DIST")
+      ->default_str("key light of the view");
   app.add_option("--rho", o->rho,
                  "Weight of staying close to the transfer function (<0: 1/mu_max)");
   app.add_option("--q", o->q, "Weight of seeing the important parts from the camera");
   app.add_option("--r", o->r, "Weight of lighting the important parts (0: no light grids)");
-  app.add_option("--optimizer", o->optimizer, "ademamix (default) or adam");
+  app.add_option("--optimizer", o->optimizer, "ademamix or adam");
   app.add_option("--lr", o->lr, "Learning rate in units of mu_max per step");
   app.add_option("--mu-max", o->muMax,
                  "Upper bound of the extinction (0: the transfer function's)");
@@ -103,11 +112,12 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--frustum-scale", o->frustumScale, "Frustum rays per image pixel (per side)");
   app.add_option("--context", o->contexts,
                  "Context surface (repeatable): iso:VALUE[:inside-high|inside-low], mesh:FILE "
-                 "or vdb:FILE");
+                 "or vdb:FILE")
+      ->default_str("");
   auto* shellOpt = app.add_option("--shell", o->shell,
                                   "Context surfaces as thin shells reaching D (world units) to "
-                                  "either side of the surface (Eq. 26; default for iso: one "
-                                  "voxel, for mesh: and vdb: filled)");
+                                  "either side of the surface (Eq. 26)")
+                       ->default_str("one voxel for iso:, filled for mesh: and vdb:");
   app.add_flag("--filled", o->filled,
                "Context surfaces filled (default for mesh: and vdb:; an isosurface of a scan is "
                "a thin shell unless this is given)")
@@ -115,11 +125,11 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--lambda", o->lambda,
                  "How strongly surfaces return to their base shape (Eq. 23)");
   app.add_option("--level-set-reach", o->reach,
-                 "How far surfaces can travel per run, in bounding radii (default 1; 0: a fixed "
-                 "number of level-set substeps per iteration)");
+                 "How far surfaces can travel per run, in bounding radii (0: a fixed number of "
+                 "level-set substeps per iteration)");
   app.add_option("--level-set-band", o->band,
                  "Half-width in voxels of the narrow band the level-set step and redistancing run "
-                 "in (default 6; 0: the whole grid, the dense reference path)");
+                 "in (0: the whole grid, the dense reference path)");
   app.add_option("--redist-iterations", o->redistIterations,
                  "Redistancing iterations at most (Eq. 18)");
   app.add_option("--world-mask", o->worldMask,

@@ -20,7 +20,7 @@ Runner addRenderCommand(CLI::App& app) {
     std::string volume, scene, session, tf, size = "512x512", camera, precision = "fp32", out;
     std::string deviationColormap = "viridis";
     int resolution = 128;
-    float step = 0.5f;
+    float step = RenderSettings{}.stepFactor;  // the library's default
     bool deviationView = false, preview = false, json = false, noJitter = false;
   };
   auto o = std::make_shared<Options>();
@@ -35,11 +35,13 @@ Runner addRenderCommand(CLI::App& app) {
       ->excludes(sceneOption);
   app.add_option("--resolution", o->resolution, "Built-in scene resolution (longest axis, voxels)");
   app.add_option("--tf", o->tf,
-                 "Transfer function: a JSON file (visopt or ParaView) or preset:NAME");
+                 "Transfer function: a JSON file (visopt or ParaView) or preset:NAME")
+      ->default_str("the session's or scene's own; preset:generic for a volume");
   app.add_option("--size", o->size, "Image size WxH");
   app.add_option("--camera", o->camera,
                  "Orbit AZ,EL,DIST: degrees about +z, degrees above the xy-plane, distance in "
-                 "bounding-sphere radii");
+                 "bounding-sphere radii")
+      ->default_str("the session's or scene's view");
   app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
   app.add_option("--step", o->step, "Ray-march step in units of the smallest voxel spacing");
   app.add_flag("--deviation-view", o->deviationView,

@@ -22,12 +22,14 @@ Runner addSdfCommand(CLI::App& app) {
   app.add_option("--mesh", o->mesh, "Triangle mesh: .obj, .ply, .off or .stl")->required();
   CLI::Option* filled = app.add_flag("--filled", o->filled, "Filled SDF (needs a closed mesh)");
   CLI::Option* shell =
-      app.add_option("--shell", o->shell, "Thin shell reaching D (world units) to either side");
+      app.add_option("--shell", o->shell, "Thin shell reaching D (world units) to either side")
+          ->default_str("");
   CLI::Option* like =
       app.add_option("--like", o->like, "Sample on the grid of this volume (dims, spacing, ...)");
-  CLI::Option* voxel = app.add_option("--voxel", o->voxel, "Cubic voxel size in world units");
+  CLI::Option* voxel =
+      app.add_option("--voxel", o->voxel, "Cubic voxel size in world units")->default_str("");
   CLI::Option* padding =
-      app.add_option("--padding", o->padding, "Voxels around the mesh's bounding box (default 3)");
+      app.add_option("--padding", o->padding, "Voxels around the mesh's bounding box");
   app.add_option("--out", o->out, "Output OpenVDB file (.vdb)")->required();
   app.add_flag("--json", o->json, "Print one JSON object");
 

@@ -13,6 +13,9 @@ int main(int argc, char** argv) {
   using namespace visopt::cli;
   CLI::App app{"visopt: visibility optimization for direct and indirect volume rendering"};
   app.require_subcommand(1);
+  // Every option's help shows its default (the value it holds before parsing); subcommands
+  // inherit this.
+  app.option_defaults()->always_capture_default();
   std::map<CLI::App*, Runner> runners;
   auto add = [&](Runner (*f)(CLI::App&), const char* name, const char* help) {
     CLI::App* sub = app.add_subcommand(name, help);

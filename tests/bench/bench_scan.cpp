@@ -16,6 +16,12 @@
 // frac (that / the probe's triad): minimum bytes = read mu and g once (2 V b), write d once and,
 // with a surface, the running maximum of g behind each cell (F b each); b = 2 or 4.
 // Environment: VISOPT_BENCH_FULL=1 adds the 256^3 volume with the 512^2 frustum.
+//
+// The extinction step (paper 000 Eqs. 10-14: gather d_V from the view grid, AdEMAMix step,
+// projection) in the same run, per voxel: the reference ExtinctionStep (one voxel per launch
+// item, what CUDA runs) and the CPU backend's rows (host/extinction_step_rows.h). Counters:
+// ns_voxel_core, GBs and frac with minimum bytes = read mu, mu_bar, m1, m2, rms and write mu, m1,
+// m2, rms once (9 V b) plus the view grid's cells read once (min(F, 8 V) b).
 #include <benchmark/benchmark.h>
 
 #include <tbb/info.h>
@@ -32,7 +38,9 @@
 #include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "host/extinction_step_rows.h"
 #include "host/visibility_scan_tiles.h"
+#include "kernels/extinction_step.h"
 #include "kernels/visibility_scan_fast.h"
 #include "stream_probe.h"
 #include "visopt/camera.h"
@@ -169,6 +177,64 @@ void runCase(benchmark::State& state, const Case& c) {
   state.counters["V"] = sums.gMu > 0 ? sums.gMuT / sums.gMu : 0.0;
 }
 
+// The extinction step on the view grid's d from the tiled scan (mu_bar: the stored mu).
+void runStepCase(benchmark::State& state, int n, int frustumSide, Precision p, bool rows) {
+  Fields& f = fieldsFor(n, p);
+  const Case scanCase{Kernel::Tiled, n, frustumSide, p, false};
+  const visopt::FrustumGrid frustum = frustumFor(scanCase, f.grid);
+  visopt::GridSpec fg;
+  fg.dims = visopt::frustumStorageDims(frustum.dims);
+  visopt::Field3D d("d", fg, p);
+  visopt::VisibilityScan s;
+  s.frustum = visopt::FrustumMap(frustum);
+  s.volume = visopt::GridMap(f.grid);
+  s.mu = visopt::FieldView(f.mu);
+  s.importance = visopt::FieldView(f.g);
+  s.out = visopt::FrustumFieldView(d, frustum.dims);
+  visopt::scanTilesOnHost("bench scan", s);
+  visopt::Field3D mu("mu", f.grid, p), m1("m1", f.grid, p), m2("m2", f.grid, p),
+      rms("rms", f.grid, p);
+  for (size_t v = 0; v < mu.size(); ++v) {
+    mu.set(v, f.mu.get(v));
+    m1.set(v, 0.f);
+    m2.set(v, 0.f);
+    rms.set(v, 0.f);
+  }
+  visopt::ExtinctionStep step;
+  step.gradient.volume = visopt::GridMap(f.grid);
+  step.gradient.mu = visopt::FieldView(mu);
+  step.gradient.base.field = visopt::FieldView(f.mu);
+  step.gradient.rho = 1.f / 8.f;
+  step.gradient.q = 40.f;
+  step.gradient.view = visopt::FrustumMap(frustum);
+  step.gradient.dView = visopt::FrustumFieldView(d, frustum.dims);
+  step.state.m1 = visopt::FieldView(m1);
+  step.state.m2 = visopt::FieldView(m2);
+  step.state.rms = visopt::FieldView(rms);
+  step.coefficients.lr = 0.4f;
+  step.coefficients.alpha = 5.f;
+  step.muMax = 8.f;
+  const int64_t voxels = int64_t(f.grid.voxelCount());
+  auto once = [&] {
+    if (rows) return visopt::extinctionStepOnHost("bench step", step);
+    return visopt::exec::reduce(
+        "bench step", voxels, visopt::StepSums{}, step,
+        [](const visopt::StepSums& a, const visopt::StepSums& b) { return a + b; });
+  };
+  for (auto _ : state) benchmark::DoNotOptimize(once());
+  const double b = double(visopt::bytesPerValue(p));
+  const double cells = double(frustum.dims.x) * frustum.dims.y * frustum.dims.z;
+  const double bytes = 9.0 * double(voxels) * b + std::min(cells, 8.0 * double(voxels)) * b;
+  state.counters["ns_voxel_core"] = benchmark::Counter(
+      double(voxels) / (1e9 * tbb::info::default_concurrency()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["GBs"] =
+      benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  if (stream().triadGBs > 0)
+    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
+                                                benchmark::Counter::kIsIterationInvariantRate);
+}
+
 std::vector<Case> cases() {
   const char* env = std::getenv("VISOPT_BENCH_FULL");
   const bool full = env && *env && std::string(env) != "0";
@@ -193,6 +259,17 @@ int main(int argc, char** argv) {
         ->UseRealTime()
         ->MinTime(0.5)
         ->Unit(benchmark::kMillisecond);
+  for (int n : {64, 128, 256})
+    for (Precision p : {Precision::FP32, Precision::FP16})
+      for (bool rows : {false, true}) {
+        const std::string name = std::string("extinction-step/") + (rows ? "rows" : "reference") +
+                                 "/vol:" + std::to_string(n) + "/view:256/" + visopt::toString(p);
+        benchmark::RegisterBenchmark(
+            name.c_str(), [=](benchmark::State& st) { runStepCase(st, n, 256, p, rows); })
+            ->UseRealTime()
+            ->MinTime(0.5)
+            ->Unit(benchmark::kMillisecond);
+      }
   const size_t llc = visopt::bench::lastLevelCacheBytes();
   const size_t arrayBytes = std::clamp<size_t>(2 * llc, size_t(256) << 20, size_t(1) << 30);
   stream() = visopt::bench::runStreamProbe(arrayBytes, 5);

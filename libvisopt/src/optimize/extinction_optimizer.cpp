@@ -10,6 +10,7 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "host/extinction_step_rows.h"
 #include "host/visibility_scan_tiles.h"
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan_fast.h"
@@ -563,9 +564,13 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
     L.gradientScale = rms > 1e-30 && std::isfinite(rms) ? float(1.0 / rms) : 1.f;
   }
   step.gradientScale = L.gradientScale;
+  // The CPU runs rows of voxels in SIMD lanes (host/extinction_step_rows.h), CUDA one voxel
+  // per thread; the tests hold the two to each other.
   StepSums sums =
-      exec::reduce("extinction step", int64_t(L.grid.voxelCount()), StepSums{}, step,
-                   [] VISOPT_HD(const StepSums& a, const StepSums& b) { return a + b; });
+      activeBackend() == Backend::CPU
+          ? extinctionStepOnHost("extinction step", step)
+          : exec::reduce("extinction step", int64_t(L.grid.voxelCount()), StepSums{}, step,
+                         [] VISOPT_HD(const StepSums& a, const StepSums& b) { return a + b; });
   st.extinctionStepMs = msSince(t1);
 
   st.iteration = t;

@@ -1,0 +1,156 @@
+#include "host/extinction_step_rows.h"
+
+#include <algorithm>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include "core/field_access.h"
+#include "exec/parallel.h"
+
+namespace visopt {
+namespace {
+
+constexpr int kLanes = 16;
+
+// FrustumMap::toGrid with its "behind the eye" return as a select, so that a loop over lanes
+// vectorises: the same operations in the same order for a point in front of the eye.
+VISOPT_INLINE glm::vec3 toGridSelect(const FrustumMap& f, glm::vec3 x) {
+  const glm::vec3 d = x - f.eye;
+  const float z = glm::dot(d, f.forward);
+  const float s = glm::length(d);
+  const float u = glm::dot(d, f.right) / (z * f.tanX);
+  const float v = glm::dot(d, f.up) / (z * f.tanY);
+  // Every value computed, then selected: arithmetic on one side of a ?: alone keeps g++ from
+  // if-converting the loop (it might raise a floating-point exception the other side avoids).
+  const float gx = (u + 1.f) * 0.5f * float(f.dims.x) - 0.5f;
+  const float gy = (v + 1.f) * 0.5f * float(f.dims.y) - 0.5f;
+  const float gz = (s - f.sNear) / f.ds - 0.5f;
+  const bool front = z > 0.f;
+  return glm::vec3(front ? gx : -1e30f, front ? gy : -1e30f, front ? gz : -1e30f);
+}
+
+// One row's chunk of n <= kLanes voxels starting at voxel index v0 = (j, k) row's i0.
+template <class A, bool kAdemamix>
+struct RowStep {
+  const ExtinctionStep& step;
+  A mu, m1, m2, rms;
+
+  void chunk(size_t v0, int i0, int j, int k, int n, double energy[kLanes],
+             double step2[kLanes]) const {
+    const ExtinctionGradient& grad = step.gradient;
+    const OptimizerCoefficients& c = step.coefficients;
+    // The voxels' positions in the frusta (vectorised).
+    float vx[kLanes], vy[kLanes], vz[kLanes], lx[kLanes], ly[kLanes], lz[kLanes];
+    for (int l = 0; l < n; ++l) {
+      const glm::vec3 x = grad.volume.toWorld(glm::vec3(float(i0 + l), float(j), float(k)));
+      const glm::vec3 yv = toGridSelect(grad.view, x), yl = toGridSelect(grad.light, x);
+      vx[l] = yv.x, vy[l] = yv.y, vz[l] = yv.z;
+      lx[l] = yl.x, ly[l] = yl.y, lz[l] = yl.z;
+    }
+    // d_V, d_L and mu_bar: gathers, one voxel at a time (gatherFrustum's rules).
+    float dv[kLanes], dl[kLanes], mbar[kLanes];
+    const bool viewOn = grad.q != 0.f && grad.dView.valid();
+    const bool lightOn = grad.r != 0.f && grad.dLight.valid();
+    for (int l = 0; l < n; ++l) {
+      const glm::vec3 yv(vx[l], vy[l], vz[l]), yl(lx[l], ly[l], lz[l]);
+      dv[l] = viewOn && grad.dView.inside(yv) ? grad.dView.sample(yv) : 0.f;
+      dl[l] = lightOn && grad.dLight.inside(yl) ? grad.dLight.sample(yl) : 0.f;
+      mbar[l] = grad.base.at(v0 + size_t(l));
+    }
+    // The gradient (ExtinctionGradient::at; a term that is off has d = 0 and adds nothing) and
+    // the optimiser step (OptimizerState::step), vectorised. The sums go to local lanes first:
+    // the caller's arrays might alias the fields as far as the compiler can tell.
+    double e[kLanes] = {}, s2[kLanes] = {};
+    for (int l = 0; l < n; ++l) {
+      const size_t v = v0 + size_t(l);
+      const float m = mu.load(v);
+      float g = grad.rho * (m - mbar[l]);
+      g -= grad.q * dv[l];
+      g -= grad.r * dl[l];
+      g = step.gradientScale * g;
+      const float first = c.beta1 * m1.load(v) + (1.f - c.beta1) * g;
+      m1.store(v, first);
+      const float r0 = rms.load(v);
+      const float r = sqrtf(c.beta2 * r0 * r0 + (1.f - c.beta2) * g * g);
+      rms.store(v, r);
+      const float denom = r / c.biasCorrection2 + c.epsilon;
+      float numer = first / c.biasCorrection1;
+      if constexpr (kAdemamix) {
+        const float slow = c.beta3 * m2.load(v) + (1.f - c.beta3) * g;
+        m2.store(v, slow);
+        numer += c.alpha * slow;
+      }
+      const float delta = -c.lr * numer / denom;
+      const float next = minOf(maxOf(m + delta, 0.f), step.muMax);
+      mu.store(v, next);
+      const float stored = mu.kept(next);
+      const double dm = double(m - mbar[l]);
+      e[l] = 0.5 * double(grad.rho) * dm * dm * double(step.voxelVolume);
+      s2[l] = double(stored - m) * double(stored - m);
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      energy[l] += e[l];
+      step2[l] += s2[l];
+    }
+  }
+
+  StepSums rows(int64_t first, int64_t last) const {
+    const glm::ivec3 dims = step.gradient.volume.dims;
+    double energy[kLanes] = {}, step2[kLanes] = {};
+    for (int64_t r = first; r < last; ++r) {
+      const int j = int(r % dims.y), k = int(r / dims.y);
+      const size_t base = size_t(r) * size_t(dims.x);
+      for (int i0 = 0; i0 < dims.x; i0 += kLanes)
+        chunk(base + size_t(i0), i0, j, k, std::min(kLanes, dims.x - i0), energy, step2);
+    }
+    StepSums sums;
+    for (int l = 0; l < kLanes; ++l) {
+      sums.energyRho += energy[l];
+      sums.step2 += step2[l];
+    }
+    return sums;
+  }
+};
+
+template <class A>
+A accessOf(const FieldView& f) {
+  if constexpr (std::is_same_v<A, Fp16Access>)
+    return {static_cast<Half*>(f.data)};
+  else
+    return {static_cast<float*>(f.data)};
+}
+
+template <class A, bool kAdemamix>
+StepSums runRows(const ExtinctionStep& step) {
+  const OptimizerState& s = step.state;
+  const RowStep<A, kAdemamix> k{step, accessOf<A>(step.gradient.mu), accessOf<A>(s.m1),
+                                kAdemamix ? accessOf<A>(s.m2) : A{}, accessOf<A>(s.rms)};
+  const glm::ivec3 dims = step.gradient.volume.dims;
+  const int64_t rows = int64_t(dims.y) * dims.z;
+  return tbb::parallel_reduce(
+      tbb::blocked_range<int64_t>(0, rows), StepSums{},
+      [&](const tbb::blocked_range<int64_t>& r, StepSums acc) {
+        return acc + k.rows(r.begin(), r.end());
+      },
+      [](const StepSums& a, const StepSums& b) { return a + b; });
+}
+
+}  // namespace
+
+StepSums extinctionStepOnHost(const char* name, const ExtinctionStep& step) {
+  const ExtinctionGradient& g = step.gradient;
+  const OptimizerState& s = step.state;
+  const bool ademamix = step.coefficients.ademamix;
+  const bool half = g.mu.half;
+  const bool oneType = s.m1.half == half && s.rms.half == half && (!ademamix || s.m2.half == half);
+  const int64_t voxels = int64_t(g.volume.dims.x) * g.volume.dims.y * g.volume.dims.z;
+  if (!oneType || (ademamix && !s.m2.valid()))
+    return exec::reduce(name, voxels, StepSums{}, step,
+                        [](const StepSums& a, const StepSums& b) { return a + b; });
+  exec::LaunchTimer timer(name, double(voxels));
+  if (half) return ademamix ? runRows<Fp16Access, true>(step) : runRows<Fp16Access, false>(step);
+  return ademamix ? runRows<Fp32Access, true>(step) : runRows<Fp32Access, false>(step);
+}
+
+}  // namespace visopt

@@ -7,7 +7,7 @@ PACKAGES=(
   libtbb-dev libglm-dev nlohmann-json3-dev libpng-dev zlib1g-dev libcli11-dev
   libvtk9-dev libvtkgdcm-dev libopenvdb-dev libboost-iostreams-dev libopenmesh-dev
   liblz4-dev libzstd-dev libgtest-dev libbenchmark-dev
-  qt6-base-dev xvfb xauth
+  qt6-base-dev xvfb xauth clang-format
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -17,6 +17,13 @@
 #include "core/half.h"
 #include "core/hd.h"
 
+// Outside the namespace: included within it, the intrinsics' declarations would land in visopt::
+// whenever this header came first (it did in test_shading).
+#if !defined(__CUDA_ARCH__) && defined(__SSE__)
+#include <xmmintrin.h>
+#define VISOPT_RAY_SSE 1
+#endif
+
 #if defined(__CUDACC__) && !defined(__CUDA_ARCH__) && defined(__F16C__)
 #include <immintrin.h>
 #define VISOPT_RAY_F16C 1
@@ -36,11 +43,6 @@ VISOPT_HD VISOPT_INLINE float rayLoadHalf(const Half* data, size_t i) {
 VISOPT_HD VISOPT_INLINE float rayLoad(const void* data, bool half, size_t i) {
   return half ? rayLoadHalf(static_cast<const Half*>(data), i) : static_cast<const float*>(data)[i];
 }
-
-#if !defined(__CUDA_ARCH__) && defined(__SSE__)
-#include <xmmintrin.h>
-#define VISOPT_RAY_SSE 1
-#endif
 
 // 1 / sqrt(x) for x > 0 and 1 / x: on the host the hardware estimates refined by one Newton
 // step (relative error below 1e-6), which keep the divider free; sqrtf and division otherwise.

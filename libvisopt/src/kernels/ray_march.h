@@ -36,31 +36,21 @@
 #include "kernels/ray_fast_math.h"
 #include "kernels/ray_skip.h"
 #include "kernels/ray_stencil.h"
+#include "kernels/shading.h"
 #include "kernels/surface_render.h"
 #include "kernels/transfer_lookup.h"
 #include "kernels/volume_extinction.h"
 
 namespace visopt {
 
-constexpr float kPi = 3.14159265358979f;
-
-// Reference forms of the two phase functions; RayMarchKernel evaluates the same expressions with
-// per-launch constants folded in.
-VISOPT_HD inline float henyeyGreenstein(float cosTheta, float g) {
-  float d = 1.f + g * g - 2.f * g * cosTheta;
-  return (1.f - g * g) / (4.f * kPi * d * sqrtf(d));
-}
-
-// Normalised Blinn-Phong with the cosine factor, two-sided about n.
-VISOPT_HD inline float blinnPhong(glm::vec3 n, glm::vec3 toLight, glm::vec3 toEye, float kd,
-                                  float ks, float shininess) {
-  if (glm::dot(n, toEye) < 0.f) n = -n;
-  float cosL = glm::dot(n, toLight);
-  if (cosL <= 0.f) return 0.f;
-  glm::vec3 h = glm::normalize(toLight + toEye);
-  float cosH = fmaxf(glm::dot(n, h), 0.f);
-  return (kd / kPi + ks * (shininess + 8.f) / (8.f * kPi) * powf(cosH, shininess)) * cosL;
-}
+// The fast host forms of kernels/shading.h's square root and power (kernels/ray_fast_math.h).
+struct RayFastMath {
+  int shininessInt = 0;  // see rayWholeExponent
+  VISOPT_HD VISOPT_INLINE float rsqrt(float x) const { return rayRsqrt(x); }
+  VISOPT_HD VISOPT_INLINE float pow(float x, float y) const {
+    return rayPowUnit(x, y, shininessInt);
+  }
+};
 
 // A small integer hash for per-pixel jitter (deterministic for a seed).
 VISOPT_HD inline float hashToUnit(uint32_t x) {
@@ -108,12 +98,12 @@ struct RayMarchParams {
 struct RayMarchKernel {
   RayMarchParams p;
   // Derived once on the host (see the constructor).
-  glm::mat3 gradientToWorld{1.f};  // index-space gradient -> world direction
-  bool lightAtFrustumEye = false;  // the light frustum's eye is the light (the fast T_L lookup)
-  float hgNorm = 0.f, hgA = 1.f, hgB = 0.f;  // HG = hgNorm / (d sqrt d), d = hgA - hgB cos
-  float kdNorm = 0.f, ksNorm = 0.f;          // kd / pi, ks (n + 8) / (8 pi)
-  float halfInvSurfaceGradient = 1.f;        // 0.5 / surfaceGradient
-  int shininessInt = 0;                      // see rayWholeExponent
+  glm::mat3 gradientToWorld{1.f};      // index-space gradient -> world direction
+  bool lightAtFrustumEye = false;      // the light frustum's eye is the light (the fast T_L lookup)
+  HenyeyGreenstein phaseFunction;      // kernels/shading.h, constants folded once
+  NormalisedBlinnPhong brdf;           // the gradient-shading lobe
+  RayFastMath fastMath;                // what both evaluate with
+  float halfInvSurfaceGradient = 1.f;  // 0.5 / surfaceGradient
   float lightGridScaleX = 1.f, lightGridScaleY = 1.f, lightGridOffsetX = 0.f,
         lightGridOffsetY = 0.f;  // pixel coordinate = numerator / z * scale + offset
   float lightInvDs = 1.f, lightDepthOffset = 0.f;  // depth coordinate = s / ds - offset
@@ -125,13 +115,10 @@ struct RayMarchKernel {
                                                      glm::vec3(0.f, invSpacing.y, 0.f),
                                                      glm::vec3(0.f, 0.f, invSpacing.z));
     lightAtFrustumEye = p.light.eye == p.lightPosition;
-    hgNorm = (1.f - p.hg * p.hg) / (4.f * kPi);
-    hgA = 1.f + p.hg * p.hg;
-    hgB = 2.f * p.hg;
-    kdNorm = p.kd / kPi;
+    phaseFunction = HenyeyGreenstein(p.hg);
+    brdf = NormalisedBlinnPhong(p.kd, p.ks, p.shininess);
+    fastMath.shininessInt = rayWholeExponent(p.shininess);
     halfInvSurfaceGradient = 0.5f / p.surfaceGradient;
-    shininessInt = rayWholeExponent(p.shininess);
-    ksNorm = p.ks * (p.shininess + 8.f) / (8.f * kPi);
     lightGridScaleX = 0.5f * float(p.light.dims.x) / p.light.tanX;
     lightGridScaleY = 0.5f * float(p.light.dims.y) / p.light.tanY;
     lightGridOffsetX = 0.5f * float(p.light.dims.x) - 0.5f;
@@ -142,9 +129,7 @@ struct RayMarchKernel {
   }
 
   VISOPT_HD VISOPT_INLINE float phaseHG(float cosTheta) const {
-    const float d = hgA - hgB * cosTheta;
-    const float r = rayRsqrt(d);
-    return hgB == 0.f ? hgNorm : hgNorm * (r * r * r);
+    return phaseFunction(cosTheta, fastMath);
   }
 
   // Per-ray linear forms for the light: with x(t) = eye + t dir the world position,
@@ -365,18 +350,7 @@ struct RayMarchKernel {
             const glm::vec3 gw = gradientToWorld * g2;
             glm::vec3 n = gw * rayRsqrt(glm::dot(gw, gw));
             if (glm::dot(n, toEye) < 0.f) n = -n;  // two-sided
-            const float cosL = glm::dot(n, toLight);
-            float bp = 0.f;
-            if (cosL > 0.f) {
-              float lobe = kdNorm;
-              if (ksNorm > 0.f) {
-                const glm::vec3 sum = toLight + toEye;
-                const glm::vec3 half = sum * rayRsqrt(glm::dot(sum, sum));
-                const float cosH = glm::dot(n, half);
-                lobe += ksNorm * rayPowUnit(cosH > 0.f ? cosH : 0.f, p.shininess, shininessInt);
-              }
-              bp = lobe * cosL;
-            }
+            const float bp = brdf.cosWeighted(n, toLight, toEye, fastMath);
             phase = (1.f - weight) * phase + weight * bp;
           }
         }

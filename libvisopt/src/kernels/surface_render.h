@@ -65,7 +65,7 @@ VISOPT_HD inline glm::vec3 surfaceRadiance(const SurfaceRenderParams& s, const G
     color =
         colormapColor(s.deviationColormap, fabsf(s.bases[surface].sample(idx)) * s.deviationScale);
   color = overlayAlbedo(s, idx, color, false);
-  const float brdf = surfaceBrdfCos(n, toLight, toEye, 1.f, s.ks, s.shininess);
+  const float brdf = NormalisedBlinnPhong(1.f, s.ks, s.shininess).cosWeighted(n, toLight, toEye);
   float ao = 1.f;
   if (s.ambientOcclusion)
     ao = sdfOcclusion(s.surfaces, grid, world, n, s.aoRadius) * volumeOcclusion;

@@ -1,7 +1,7 @@
 // Shading of the context surfaces (paper 000 Eq. 8 and §III-E): the reduced surface radiance
 //   L_r = T_V f_r (n . wL)+ L_i,  L_i = T_L L_e  (Eq. 9),
-// with a normalised Blinn-Phong BRDF f_r, ambient occlusion from the SDF and from the volume. The
-// deviation view's colormaps live in core/colormap_eval.h.
+// with the normalised Blinn-Phong BRDF f_r of kernels/shading.h, ambient occlusion from the SDF and
+// from the volume. The deviation view's colormaps live in core/colormap_eval.h.
 #pragma once
 
 #include <cmath>
@@ -11,21 +11,10 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
+#include "kernels/shading.h"
 #include "kernels/surface_set.h"
 
 namespace visopt {
-
-// Normalised Blinn-Phong BRDF times the cosine: kd/pi + ks (n+8)/(8 pi) cos^n(h) — Eq. 8's
-// f_r (n . wL)+ for albedo kd.
-VISOPT_HD inline float surfaceBrdfCos(glm::vec3 n, glm::vec3 toLight, glm::vec3 toEye, float kd,
-                                      float ks, float shininess) {
-  const float cosL = glm::dot(n, toLight);
-  if (cosL <= 0.f) return 0.f;
-  const glm::vec3 h = glm::normalize(toLight + toEye);
-  const float cosH = fmaxf(glm::dot(n, h), 0.f);
-  return (kd / 3.14159265f + ks * (shininess + 8.f) / (8.f * 3.14159265f) * powf(cosH, shininess)) *
-         cosL;
-}
 
 // grad phi in the grid's local axes (world units, unnormalised) at index position p by central
 // differences over +-o voxels.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fetches, verifies (sha256) and converts the real datasets listed in DATASETS.md into a form
+# Fetches, verifies (sha256) and converts the real datasets listed in docs/datasets.md into a form
 # visopt's readVolume takes. Only Debian's package archive is needed: packages are fetched with
 # `apt-get download` (never installed) and single files pulled out with dpkg-deb | tar.
 #

@@ -1,7 +1,7 @@
-// Paper 000 Table I, the context-surface columns, on the CPU: "SDF Opt." (one explicit Euler
-// substep of the level-set PDE, Eq. 23) and "Redist." (one redistancing iteration, Eq. 18) on
-// dense 64^3 / 128^3 / 256^3 grids in fp32 and fp16, reported in ns per voxel-iteration; and,
-// in the same run, OpenVDB's LevelSetTracker renormalisation (first-order Godunov FIRST_BIAS,
+// Himmler & Günther 2026, Table I, the context-surface columns, on the CPU: "SDF Opt." (one
+// explicit Euler substep of the level-set PDE, Eq. 23) and "Redist." (one redistancing iteration,
+// Eq. 18) on dense 64^3 / 128^3 / 256^3 grids in fp32 and fp16, reported in ns per voxel-iteration;
+// and, in the same run, OpenVDB's LevelSetTracker renormalisation (first-order Godunov FIRST_BIAS,
 // Euler TVD_RK1, one normalize() iteration) on the same sphere, for a narrow band (half-width
 // 3 voxels) and for a band wide enough to cover the whole grid (clipped to it), in ns per active
 // voxel-iteration and ms per iteration. See docs/level-set-benchmarks.md.

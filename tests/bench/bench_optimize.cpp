@@ -1,6 +1,6 @@
-// Paper 000 Table I on the CPU: the two stages of one extinction-optimisation iteration,
-// "grid updates" (the visibility scans of the view and light frustum grids) and "extinction
-// step" (gather, AdEMAMix step, projection), in ms per iteration at every level of the
+// Himmler & Günther 2026, Table I on the CPU: the two stages of one extinction-optimisation
+// iteration, "grid updates" (the visibility scans of the view and light frustum grids) and
+// "extinction step" (gather, AdEMAMix step, projection), in ms per iteration at every level of the
 // coarse-to-fine multigrid, for fp32 and fp16 storage, built-in scenes at 64^3..256^3 and
 // 256^2 / 512^2 view frustum grids; plus the memory of every field (the engine's ledger) and
 // each stage's achieved memory bandwidth as a fraction of a STREAM probe run in the same process.

@@ -1,5 +1,5 @@
-// The grid updates (paper 000 Eqs. 10-13: the visibility scan of one frustum grid) kernel by
-// kernel, on the same fields in the same run, against a STREAM-like probe run in the same
+// The grid updates (Himmler & Günther 2026, Eqs. 10-13: the visibility scan of one frustum grid)
+// kernel by kernel, on the same fields in the same run, against a STREAM-like probe run in the same
 // process: the reference per-ray scan (kernels/visibility_scan.h), the fast per-ray scan
 // (kernels/visibility_scan_fast.h, buffered: what a one-thread-per-ray backend runs) and the
 // tiled scan the CPU backend runs (host/visibility_scan_tiles.h). All three use the tiled layout
@@ -17,8 +17,8 @@
 // with a surface, the running maximum of g behind each cell (F b each); b = 2 or 4.
 // Environment: VISOPT_BENCH_FULL=1 adds the 256^3 volume with the 512^2 frustum.
 //
-// The extinction step (paper 000 Eqs. 10-14: gather d_V from the view grid, AdEMAMix step,
-// projection) in the same run, per voxel: the reference ExtinctionStep (one voxel per launch
+// The extinction step (Himmler & Günther 2026, Eqs. 10-14: gather d_V from the view grid, AdEMAMix
+// step, projection) in the same run, per voxel: the reference ExtinctionStep (one voxel per launch
 // item, what CUDA runs) and the CPU backend's rows (host/extinction_step_rows.h). Counters:
 // ns_voxel_core, GBs and frac with minimum bytes = read mu, mu_bar, m1, m2, rms and write mu, m1,
 // m2, rms once (9 V b) plus the view grid's cells read once (min(F, 8 V) b).

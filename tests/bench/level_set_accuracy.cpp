@@ -1,6 +1,6 @@
-// The speed/accuracy trade of the context-surface optimisation (paper 000 §III, Eqs. 18-23): on a
-// built-in scene with its context surface, for each number of redistancing iterations per
-// optimisation iteration, storage precision and number of multigrid levels, the wall time of
+// The speed/accuracy trade of the context-surface optimisation (Himmler & Günther 2026, §III, Eqs.
+// 18-23): on a built-in scene with its context surface, for each number of redistancing iterations
+// per optimisation iteration, storage precision and number of multigrid levels, the wall time of
 // Engine::optimize(), the deviation of the final surface from a converged fp32 reference, and the
 // error of the rendered image against the reference's.
 //

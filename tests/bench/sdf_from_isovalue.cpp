@@ -1,5 +1,5 @@
-// Times sdfFromIsovalue (the base SDF phi0 of an isosurface context, paper 000 Eq. 18 from
-// s(x) - iso) on a volume file, and optionally writes phi (fp32, voxels in x-fastest order,
+// Times sdfFromIsovalue (the base SDF phi0 of an isosurface context, Himmler & Günther 2026, Eq. 18
+// from s(x) - iso) on a volume file, and optionally writes phi (fp32, voxels in x-fastest order,
 // world units) to a raw file, or compares it with such a file written earlier: the mean and max
 // |phi - phi_other| in voxels over the whole grid and over the band within 3 voxels of the
 // surface in both.

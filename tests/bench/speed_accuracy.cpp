@@ -1,6 +1,6 @@
-// The speed/accuracy trade of the extinction optimisation (paper 000 §II-C): for each storage
-// precision, number of multigrid levels, view frustum scale and per-level iteration budget, the
-// wall time of Engine::optimize() and the error of the rendered image against a converged
+// The speed/accuracy trade of the extinction optimisation (Himmler & Günther 2026, §II-C): for each
+// storage precision, number of multigrid levels, view frustum scale and per-level iteration budget,
+// the wall time of Engine::optimize() and the error of the rendered image against a converged
 // reference (fp32, 3 levels, frustum scale 1, a large budget and a small tolerance): PSNR
 // (visopt::psnr, sRGB), SSIM (image_metrics.h, sRGB luma) and the relative RMS difference of the
 // optimised extinction from the reference's. Every image is rendered with the same settings and

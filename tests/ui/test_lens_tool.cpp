@@ -1,6 +1,6 @@
-// The importance lens tool (paper 000 §III-F): the cursor maps to the lens centre in normalised
-// image coordinates (y down), the wheel sets radius and strength, Escape switches it off; and a
-// lens set from the tool changes the optimisation along exactly the view rays inside it.
+// The importance lens tool (Himmler & Günther 2026, §III-F): the cursor maps to the lens centre in
+// normalised image coordinates (y down), the wheel sets radius and strength, Escape switches it
+// off; and a lens set from the tool changes the optimisation along exactly the view rays inside it.
 #include <cmath>
 #include <memory>
 #include <vector>
@@ -185,8 +185,8 @@ void TestLensTool::lensOutlineMatchesTheWeights() {
   QVERIFY(std::abs(r.height() - 20.0) < 1e-4);
 }
 
-// Paper 000 §III-F: the lens scales the importance along the view rays inside it. With
-// strength 0 the occluder in front of the important plane keeps its extinction inside the lens
+// Himmler & Günther 2026, §III-F: the lens scales the importance along the view rays inside it.
+// With strength 0 the occluder in front of the important plane keeps its extinction inside the lens
 // and is cleared elsewhere. Two lens positions (set from the tool's cursor) give the same result
 // on every voxel whose rays are inside neither lens; inside one lens only, the occluder is kept
 // with that lens and cleared with the other.

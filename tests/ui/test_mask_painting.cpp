@@ -1,6 +1,6 @@
-// World-mask painting (paper 000 §III-F, R5): the sphere brush marks exactly the voxels whose
-// centres lie within its world radius of the stroke (anisotropic spacing and a rotated grid),
-// strokes undo and redo bitwise, Escape leaves no trace, the history's memory cap drops the
+// World-mask painting (Himmler & Günther 2026, §III-F, R5): the sphere brush marks exactly the
+// voxels whose centres lie within its world radius of the stroke (anisotropic spacing and a rotated
+// grid), strokes undo and redo bitwise, Escape leaves no trace, the history's memory cap drops the
 // oldest entries, the value range limits the change, and picking finds a sphere SDF where the
 // analytic ray-sphere intersection is.
 #include <cmath>

@@ -1,7 +1,7 @@
-// The core scenario of paper 000 (Fig. 3): an important disc inside a context sphere (a thin
-// shell). The surface opens towards the camera, the disc's visibility rises from ~0 to high, the
-// surface returns to its base shape when the importance is removed, and a world mask over the
-// occluding cap keeps the cap.
+// The core scenario of Himmler & Günther 2026 (Fig. 3): an important disc inside a context sphere
+// (a thin shell). The surface opens towards the camera, the disc's visibility rises from ~0 to
+// high, the surface returns to its base shape when the importance is removed, and a world mask over
+// the occluding cap keeps the cap.
 //
 // Eq. 23 moves the surface inward by curvature only where ghat > 0 (max(0, .) forbids outward
 // motion, and grad ghat . grad phi vanishes on a cap facing the camera): a cap dented inside
@@ -123,9 +123,9 @@ TEST(ContextSurfaces, WorldMaskKeepsTheCap) {
   EXPECT_LT(stats.back().visibilityView, 0.05) << "the cap stays, so the blob stays hidden";
 }
 
-// A lens of strength 0 over the disc (paper 000 §III-F) removes the importance along exactly
-// those rays: the shell keeps its cap and the disc stays hidden; the same lens elsewhere on the
-// screen changes nothing. A screen-space windowing mask of zeros over the disc does the same.
+// A lens of strength 0 over the disc (Himmler & Günther 2026, §III-F) removes the importance along
+// exactly those rays: the shell keeps its cap and the disc stays hidden; the same lens elsewhere on
+// the screen changes nothing. A screen-space windowing mask of zeros over the disc does the same.
 TEST(ContextSurfaces, LensAndScreenMaskModulateTheImportanceAlongTheirRays) {
   auto run = [](auto configure) {
     Engine e;

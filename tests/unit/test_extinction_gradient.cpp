@@ -1,5 +1,6 @@
-// The analytic gradient of the extinction energy (paper 000 Eqs. 10-13, METHODS.md §1) against
-// central finite differences of the discrete energy (kernels/visibility_scan.h).
+// The analytic gradient of the extinction energy (Himmler & Günther 2026, Eqs. 10-13,
+// docs/methods.md §1) against central finite differences of the discrete energy
+// (kernels/visibility_scan.h).
 #include <cmath>
 #include <random>
 

@@ -1,6 +1,6 @@
-// Behaviour of the extinction optimisation (paper 000 §II-C): the optimum without importance is
-// mu_bar, an important blob behind a dense occluder becomes visible from the camera and from the
-// light, mu away from every line of sight stays at mu_bar; warm start and freezing.
+// Behaviour of the extinction optimisation (Himmler & Günther 2026, §II-C): the optimum without
+// importance is mu_bar, an important blob behind a dense occluder becomes visible from the camera
+// and from the light, mu away from every line of sight stays at mu_bar; warm start and freezing.
 #include <cmath>
 
 #include <gtest/gtest.h>

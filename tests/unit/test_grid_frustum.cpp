@@ -1,5 +1,5 @@
-// Grid geometry, frustum mappings g_V / g_L (paper 000 Eqs. 4-5) against hand-computed values,
-// and the round trip g^-1(g(x)) = x.
+// Grid geometry, frustum mappings g_V / g_L (Himmler & Günther 2026, Eqs. 4-5) against
+// hand-computed values, and the round trip g^-1(g(x)) = x.
 #include <cmath>
 
 #include <gtest/gtest.h>

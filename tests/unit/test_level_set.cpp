@@ -1,5 +1,5 @@
-// The context-surface numerics against analytic answers (paper 000 Eqs. 18, 23, 26;
-// METHODS.md §3): mean-curvature flow of a sphere, relaxation to phi0, redistancing, an SDF
+// The context-surface numerics against analytic answers (Himmler & Günther 2026, Eqs. 18, 23, 26;
+// docs/methods.md §3): mean-curvature flow of a sphere, relaxation to phi0, redistancing, an SDF
 // from an isovalue, thin shells, the world mask, and the extremes (time-step limits, fp16,
 // anisotropic spacing, tiny grids, degenerate fields).
 #include <gtest/gtest.h>

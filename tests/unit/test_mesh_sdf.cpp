@@ -1,7 +1,7 @@
-// Context surfaces from triangle meshes (paper 000 §III-B, §IV-E): a closed mesh gives a filled
-// SDF whose zero set lies within a voxel of the mesh, an open one only a thin shell; broken files
-// are refused with one line naming the file; .vdb files round-trip; the CLI maps errors to exit
-// codes.
+// Context surfaces from triangle meshes (Himmler & Günther 2026, §III-B, §IV-E): a closed mesh
+// gives a filled SDF whose zero set lies within a voxel of the mesh, an open one only a thin shell;
+// broken files are refused with one line naming the file; .vdb files round-trip; the CLI maps
+// errors to exit codes.
 #include <sys/wait.h>
 
 #include <array>

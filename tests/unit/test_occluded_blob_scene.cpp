@@ -1,6 +1,6 @@
-// The built-in scene "occluded-blob" (paper 000 Fig. 3 in volume form): with the default
-// extinction settings the important disc behind the dense wall goes from hidden (V < 0.1) to
-// visible (V > 0.8), the energy falls, and the wall away from every line of sight to the disc
+// The built-in scene "occluded-blob" (Himmler & Günther 2026, Fig. 3 in volume form): with the
+// default extinction settings the important disc behind the dense wall goes from hidden (V < 0.1)
+// to visible (V > 0.8), the energy falls, and the wall away from every line of sight to the disc
 // keeps mu_bar. Through the Engine API and through `visopt optimize --json`.
 #include <algorithm>
 #include <array>

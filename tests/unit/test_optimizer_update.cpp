@@ -1,4 +1,4 @@
-// The per-voxel optimiser updates (AdEMAMix, Adam; METHODS.md §2) against a scalar reference
+// The per-voxel optimiser updates (AdEMAMix, Adam; docs/methods.md §2) against a scalar reference
 // written here from the published update rules, and the fp16 second-moment underflow hazard.
 #include <cmath>
 

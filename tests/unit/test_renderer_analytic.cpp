@@ -1,4 +1,4 @@
-// The renderer against closed forms (paper 000 Eqs. 6-9).
+// The renderer against closed forms (Himmler & Günther 2026, Eqs. 6-9).
 #include <cmath>
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// Context surfaces in the renderer (paper 000 Eq. 8, §III-E): the reduced surface radiance
-// against its closed form, shadows through T_L, the volume behind a surface hidden, the
+// Context surfaces in the renderer (Himmler & Günther 2026, Eq. 8, §III-E): the reduced surface
+// radiance against its closed form, shadows through T_L, the volume behind a surface hidden, the
 // deviation view's colours, and the four methods of Fig. 10 differing.
 #include <cmath>
 

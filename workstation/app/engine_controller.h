@@ -1,9 +1,9 @@
 // The Engine on its own thread. The UI never calls the Engine: it posts commands that the worker
 // runs between optimisation iterations, in order, and receives frames, statistics, progress and
 // errors as signals on the UI thread. While optimisation runs, the worker alternates one
-// iteration at the current camera (paper 000 §III-F "Navigation": the optimisation follows the
-// camera, warm-started from the current mu) with a render; while the user drags the camera it
-// renders low-resolution previews first and the full image once the camera rests.
+// iteration at the current camera (Himmler & Günther 2026, §III-F "Navigation": the optimisation
+// follows the camera, warm-started from the current mu) with a render; while the user drags the
+// camera it renders low-resolution previews first and the full image once the camera rests.
 #pragma once
 
 #include <atomic>

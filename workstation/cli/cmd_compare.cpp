@@ -1,5 +1,5 @@
-// visopt compare: the four methods of paper 000 Fig. 10 side by side for one scene and camera —
-// maximum importance projection, cut-away, transparency modulation, and ours.
+// visopt compare: the four methods of Himmler & Günther 2026, Fig. 10 side by side for one scene
+// and camera — maximum importance projection, cut-away, transparency modulation, and ours.
 #include <chrono>
 #include <cstdio>
 

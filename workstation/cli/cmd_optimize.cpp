@@ -1,6 +1,6 @@
-// visopt optimize: the extinction optimisation of paper 000 §II-C on a volume or built-in scene,
-// with per-iteration statistics, before/after images and an optional second viewpoint for the
-// frozen result.
+// visopt optimize: the extinction optimisation of Himmler & Günther 2026, §II-C on a volume or
+// built-in scene, with per-iteration statistics, before/after images and an optional second
+// viewpoint for the frozen result.
 #include <atomic>
 #include <chrono>
 #include <csignal>

@@ -39,7 +39,8 @@ void checkOrbit(float azimuthDeg, float elevationDeg, float distanceInRadii,
 
 struct PointLight {
   glm::vec3 position{0.f, -3.f, 3.f};
-  float intensity = 1.f;  // L_e of paper 000 Eq. 9 (no quadratic fall-off, as in the paper)
+  float intensity =
+      1.f;  // L_e of Himmler & Günther 2026, Eq. 9 (no quadratic fall-off, as in the paper)
   glm::vec3 color{1.f};
 
   // A light above-left of the camera, a photographer's key light: the default for scenes.

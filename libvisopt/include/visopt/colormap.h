@@ -1,5 +1,6 @@
-// Colormaps for scalar overlays (the deviation view of paper 000 Fig. 5 and the workstation's
-// legends): a few perceptually ordered maps and a diverging one, evaluated in linear RGB.
+// Colormaps for scalar overlays (the deviation view of Himmler & Günther 2026, Fig. 5 and the
+// workstation's legends): a few perceptually ordered maps and a diverging one, evaluated in linear
+// RGB.
 #pragma once
 
 #include <string>

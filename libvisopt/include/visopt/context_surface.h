@@ -9,7 +9,8 @@
 
 namespace visopt {
 
-// A context surface (paper 000 §III): opaque geometry held as an SDF on the volume's grid.
+// A context surface (Himmler & Günther 2026, §III): opaque geometry held as an SDF on the volume's
+// grid.
 struct ContextSurfaceSpec {
   // "iso:VALUE[:inside-high|inside-low]" (an isosurface of the data; inside-high: values above
   // VALUE are inside, the default), "mesh:FILE" (OBJ/PLY/OFF/STL) or "vdb:FILE".

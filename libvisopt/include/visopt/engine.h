@@ -54,7 +54,7 @@ class Engine {
   void setLight(const PointLight& light);
   const PointLight& light() const;
 
-  // ---- importance g(x) in [0, 1] (paper 000 §III-A) ----
+  // ---- importance g(x) in [0, 1] (Himmler & Günther 2026, §III-A) ----
   // A piecewise-linear curve over data values: points (value, g), g in [0, 1].
   void setImportanceCurve(const std::vector<glm::dvec2>& points,
                           const std::string& origin = "importance curve");
@@ -71,7 +71,7 @@ class Engine {
   };
   const ImportanceSource& importanceSource() const;
 
-  // ---- context surfaces (paper 000 §III) ----
+  // ---- context surfaces (Himmler & Günther 2026, §III) ----
   // Builds the base SDF phi0 on the volume grid; returns the surface's index. Errors: Usage for a
   // malformed source, BadInput for unreadable files or meshes unfit for a filled SDF.
   int addContextSurface(const ContextSurfaceSpec& spec, const ProgressCallback& progress = {});
@@ -108,7 +108,7 @@ class Engine {
   // ghat (Eq. 19) of the last optimisation iteration, when there are surfaces.
   const Field3D* importanceBehind() const;
 
-  // ---- extinction optimisation (paper 000 §II-C, Eqs. 10-14) ----
+  // ---- extinction optimisation (Himmler & Günther 2026, §II-C, Eqs. 10-14) ----
   void setExtinctionSettings(const ExtinctionSettings& settings);
   const ExtinctionSettings& extinctionSettings() const;
   // The frustum grids follow this image size (set it to the render size).
@@ -130,7 +130,7 @@ class Engine {
   std::vector<IterationStats> continueOptimization(
       int iterations, const std::function<bool(const IterationStats&)>& callback = {},
       const std::function<bool()>& abandon = {});
-  // A frozen result keeps its mu when the camera moves (paper 000 §III-F, Fig. 7).
+  // A frozen result keeps its mu when the camera moves (Himmler & Günther 2026, §III-F, Fig. 7).
   void setFrozen(bool frozen);
   bool frozen() const;
   void resetOptimization();

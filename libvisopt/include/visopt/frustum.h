@@ -1,11 +1,11 @@
 // View-space and light-space frustum grids: the perspective mappings g_V and g_L of
-// paper 000 Eqs. 4-5 and their inverses.
+// Himmler & Günther 2026, Eqs. 4-5 and their inverses.
 //
 // A frustum grid has nx × ny rays (one per pixel centre of a virtual image) and nz depth cells.
 // Depth is the Euclidean distance s = |x - eye| along each ray, split uniformly in [sNear, sFar],
 // so every cell on every ray has the same length ds: transmittance scans need no Jacobian
 // along the ray. Cells are NOT equal in volume: a cell's cross-section grows as s², which the
-// gradient gather accounts for (see METHODS.md §1). Continuous grid coordinates put cell
+// gradient gather accounts for (see docs/methods.md §1). Continuous grid coordinates put cell
 // centres at integers, like GridSpec.
 #pragma once
 

@@ -1,6 +1,6 @@
-// Settings and statistics of the context-surface optimisation (paper 000 §III-B-D, Eqs. 18-23,
-// Alg. 1): level-set propagation of the SDF phi towards where it hides nothing important and
-// back to its base shape phi0 elsewhere.
+// Settings and statistics of the context-surface optimisation (Himmler & Günther 2026, §III-B-D,
+// Eqs. 18-23, Alg. 1): level-set propagation of the SDF phi towards where it hides nothing
+// important and back to its base shape phi0 elsewhere.
 #pragma once
 
 #include <cstdint>
@@ -11,8 +11,8 @@ struct LevelSetSettings {
   // Eq. 23: phi_t = max(0, ghat |grad phi| kappa + grad ghat . grad phi) + lambda(x) (phi0 - phi),
   // lambda(x) = max(0, lambda - ghat(x)).
   float lambda = 0.3f;
-  float curvatureEpsilon = 1e-6f;  // in the curvature's denominator (METHODS.md §3)
-  // Explicit Euler: each step uses cfl times the largest stable time step (METHODS.md §3),
+  float curvatureEpsilon = 1e-6f;  // in the curvature's denominator (docs/methods.md §3)
+  // Explicit Euler: each step uses cfl times the largest stable time step (docs/methods.md §3),
   // and at least `substeps` such steps run per optimisation iteration.
   float cfl = 0.5f;
   int substeps = 4;

@@ -1,4 +1,5 @@
-// Settings and statistics of the visibility optimisation (paper 000 §II-C, Eqs. 10-14).
+// Settings and statistics of the visibility optimisation (Himmler & Günther 2026, §II-C, Eqs.
+// 10-14).
 #pragma once
 
 #include <cstdint>
@@ -39,8 +40,8 @@ struct ExtinctionSettings {
   int lightGridSize = 128;  // light frustum rays per side at the finest level
 };
 
-// A circular importance lens (paper 000 §III-F, Fig. 8): inside it the importance along the view
-// rays is multiplied by `strength` (0 hides, > 1 boosts, clamped to g <= 1).
+// A circular importance lens (Himmler & Günther 2026, §III-F, Fig. 8): inside it the importance
+// along the view rays is multiplied by `strength` (0 hides, > 1 boosts, clamped to g <= 1).
 struct ImportanceLens {
   float x = 0.5f, y = 0.5f;  // centre in normalised image coordinates, y down
   float radius = 0.f;        // fraction of the image width; 0: no lens
@@ -58,10 +59,11 @@ struct IterationStats {
   // important structures, 1 when nothing does. What a structure hides of itself (its own front,
   // the back of a skull behind its front) weighs ~0 in both sums (kernels/visibility_scan.h).
   double visibilityViewOccluders = 0.0;
-  double stepNorm = 0.0;          // RMS of the change of mu over the voxels
-  double gridUpdatesMs = 0.0;     // T_V, G_V, T_L, G_L (paper 000 Table I "Grid Updates")
+  double stepNorm = 0.0;  // RMS of the change of mu over the voxels
+  double gridUpdatesMs =
+      0.0;  // T_V, G_V, T_L, G_L (Himmler & Günther 2026, Table I "Grid Updates")
   double extinctionStepMs = 0.0;  // gather, optimiser step, projection ("Ext. Opt.")
-  // Context surfaces (paper 000 Eqs. 18-23), when there are any.
+  // Context surfaces (Himmler & Günther 2026, Eqs. 18-23), when there are any.
   double sdfStepMs = 0.0;           // ghat gather and the level-set step ("SDF Opt.")
   double redistanceMs = 0.0;        // all redistancing iterations ("Redist." x iterations)
   int redistanceIterations = 0;     // the most of one redistancing call

@@ -1,4 +1,5 @@
-// How an image is rendered: single scattering of one point light (paper 000 Eqs. 6-9).
+// How an image is rendered: single scattering of one point light (Himmler & Günther 2026, Eqs.
+// 6-9).
 #pragma once
 
 #include <cstdint>
@@ -9,7 +10,7 @@
 
 namespace visopt {
 
-// The comparison baselines of paper 000 Fig. 10, and ours.
+// The comparison baselines of Himmler & Günther 2026, Fig. 10, and ours.
 enum class RenderMethod {
   Optimized,                // ours: the optimised extinction and surfaces
   MaxImportanceProjection,  // each pixel shows the sample of highest importance (surfaces too)
@@ -48,15 +49,15 @@ struct RenderSettings {
   glm::vec3 background{0.06f, 0.065f, 0.075f};
   float exposure = 1.f;
 
-  // Light-space frustum grid for T_L (paper 000 Eq. 5): rays per side, depth cells (0 = one per
-  // voxel along the volume's diagonal).
+  // Light-space frustum grid for T_L (Himmler & Günther 2026, Eq. 5): rays per side, depth cells (0
+  // = one per voxel along the volume's diagonal).
   int lightGridSize = 192;  // kMinLightGridSize..kMaxLightGridSize
   int lightGridDepth = 0;   // 0..kMaxLightGridDepth
   // Stop marching once the view transmittance drops below this.
   float earlyStop = 1e-4f;
 
-  // Context surfaces (paper 000 Eq. 8 and §III-E): shaded with normalised Blinn-Phong, shadowed
-  // through T_L, darkened by ambient occlusion from the volume and the SDF.
+  // Context surfaces (Himmler & Günther 2026, Eq. 8 and §III-E): shaded with normalised
+  // Blinn-Phong, shadowed through T_L, darkened by ambient occlusion from the volume and the SDF.
   float surfaceSpecular = 0.3f, surfaceShininess = 32.f;
   bool ambientOcclusion = true;
   float ambientOcclusionRadius = 6.f;  // in voxels

@@ -31,8 +31,8 @@ struct BuiltinScene {
   // The same structures as a curve over normalised values, points (t, g) — what a user could
   // set in an importance editor; may also catch edges that pass through the same values.
   std::vector<glm::vec2> importanceCurve;
-  // The scene's context surfaces (paper 000 §III) and the transfer function to use with them:
-  // what the surfaces show is then transparent in the volume. Empty for scenes without.
+  // The scene's context surfaces (Himmler & Günther 2026, §III) and the transfer function to use
+  // with them: what the surfaces show is then transparent in the volume. Empty for scenes without.
   std::vector<ContextSurfaceSpec> contextSurfaces;
   TransferFunction contextTransferFunction;
 };

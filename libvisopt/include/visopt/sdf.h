@@ -1,6 +1,6 @@
-// Context surfaces as signed distance fields (paper 000 §III-B): inside negative, outside
-// positive, |grad phi| = 1, in world units. A surface is used filled or as a thin shell around
-// its zero level set, phi_shell = |phi| - d (Eq. 26): the shell reaches d to either side.
+// Context surfaces as signed distance fields (Himmler & Günther 2026, §III-B): inside negative,
+// outside positive, |grad phi| = 1, in world units. A surface is used filled or as a thin shell
+// around its zero level set, phi_shell = |phi| - d (Eq. 26): the shell reaches d to either side.
 #pragma once
 
 #include <cstddef>

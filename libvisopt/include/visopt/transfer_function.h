@@ -1,5 +1,5 @@
-// Piecewise-linear transfer function over the data values (paper 000 Eq. 3): it gives the
-// scattering albedo a(x) (the colour) and the base extinction mu_bar(x).
+// Piecewise-linear transfer function over the data values (Himmler & Günther 2026, Eq. 3): it gives
+// the scattering albedo a(x) (the colour) and the base extinction mu_bar(x).
 //
 // Opacity is specified the way ParaView does: an opacity alpha means "a slab of thickness
 // `unitDistance` (world units) lets 1 - alpha of the light through", so the extinction is

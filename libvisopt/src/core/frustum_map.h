@@ -1,5 +1,6 @@
-// Device-side copies of the grid and frustum mappings (paper 000 Eqs. 4-5: g_V, g_L and their
-// inverses). The public GridSpec / FrustumGrid delegate to these, so the math exists once.
+// Device-side copies of the grid and frustum mappings (Himmler & Günther 2026, Eqs. 4-5: g_V, g_L
+// and their inverses). The public GridSpec / FrustumGrid delegate to these, so the math exists
+// once.
 #pragma once
 
 #include <glm/glm.hpp>

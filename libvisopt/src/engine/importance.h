@@ -1,5 +1,5 @@
-// Building the importance field g(x) in [0, 1] (paper 000 §III-A) from what a user gives: a
-// curve over the data values, a curve file, or a volume on the same grid.
+// Building the importance field g(x) in [0, 1] (Himmler & Günther 2026, §III-A) from what a user
+// gives: a curve over the data values, a curve file, or a volume on the same grid.
 #pragma once
 
 #include <string>

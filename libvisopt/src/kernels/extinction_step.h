@@ -1,5 +1,5 @@
-// The extinction step (paper 000 Eqs. 10-14; METHODS.md §1): per object voxel, gather the
-// per-unit-volume derivative densities d_V, d_L from the frustum grids by trilinear
+// The extinction step (Himmler & Günther 2026, Eqs. 10-14; docs/methods.md §1): per object voxel,
+// gather the per-unit-volume derivative densities d_V, d_L from the frustum grids by trilinear
 // interpolation, form
 //   dF/dmu = rho (mu - mu_bar) - q d_V - r d_L,
 // take an optimiser step and project onto [0, mu_max] (Eq. 14). A voxel outside the view

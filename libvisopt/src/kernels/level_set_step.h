@@ -1,5 +1,5 @@
-// One explicit Euler step of the context-surface PDE (paper 000 Eq. 23, Eq. 25, Alg. 1;
-// METHODS.md §3), per voxel:
+// One explicit Euler step of the context-surface PDE (Himmler & Günther 2026, Eq. 23, Eq. 25, Alg.
+// 1; docs/methods.md §3), per voxel:
 //   phi_t = max(0, ghat |grad phi| kappa + grad ghat . grad phi) + lambda(x) (phi0 - phi),
 //   lambda(x) = max(0, lambda - ghat(x)).
 // |grad phi| of the curvature part is Godunov-upwinded (Osher & Fedkiw §6.4) on the sign of
@@ -417,7 +417,7 @@ struct LevelSetStepKernel {
   }
 };
 
-// Maxima over the grid that bound the stable time step (METHODS.md §3).
+// Maxima over the grid that bound the stable time step (docs/methods.md §3).
 struct StepBounds {
   float maxGradG = 0.f;  // max |grad ghat| (central differences, world units)
   float maxG = 0.f;      // max ghat

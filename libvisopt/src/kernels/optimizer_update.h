@@ -1,4 +1,4 @@
-// Per-voxel optimiser updates: AdEMAMix (Pagliardini, Ablin, Grangier 2024; METHODS.md §2) and
+// Per-voxel optimiser updates: AdEMAMix (Pagliardini, Ablin, Grangier 2024; docs/methods.md §2) and
 // Adam, on state stored as fp32 or fp16 fields.
 //
 // fp16 hazard: the second moment nu = EMA(g^2) underflows in fp16 (smallest subnormal ~6e-8)

@@ -1,4 +1,4 @@
-// The volume part of the single-scattering renderer, paper 000 Eqs. 6-9:
+// The volume part of the single-scattering renderer, Himmler & Günther 2026, Eqs. 6-9:
 //   L(x0 <- w) = integral T_V(x) f_p(x, wL <-> w) mu_s(x) L_i(x) dx + T_V(x_s) L_background,
 //   mu_s = mu_t * a (Eq. 3), L_i(x) = T_L(g_L(x)) L_e (Eq. 9).
 // Each march segment of length h is integrated exactly for constant mu over the segment:

@@ -1,4 +1,4 @@
-// Redistancing (paper 000 Eq. 18, Sussman, Smereka & Osher 1994; METHODS.md §3):
+// Redistancing (Himmler & Günther 2026, Eq. 18, Sussman, Smereka & Osher 1994; docs/methods.md §3):
 //   phi_tau + S (|grad phi| - 1) = 0,   S(p) = p / sqrt(p^2 + dx^2),
 // with Godunov's upwind |grad phi| on the sign of S (first-order or second-order ENO one-sided
 // differences, LevelSetSettings::spatialOrder) and explicit Euler steps, double-buffered (one

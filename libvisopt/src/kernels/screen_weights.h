@@ -1,5 +1,5 @@
-// Screen-space modulation of the importance along view rays (paper 000 §III-F, Fig. 8): a
-// circular lens and a windowing mask, both evaluated per frustum ray (pixel).
+// Screen-space modulation of the importance along view rays (Himmler & Günther 2026, §III-F, Fig.
+// 8): a circular lens and a windowing mask, both evaluated per frustum ray (pixel).
 #pragma once
 
 #include <glm/glm.hpp>

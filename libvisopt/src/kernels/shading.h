@@ -1,10 +1,10 @@
-// The renderer's two scattering functions, written once (paper 000 Eqs. 5 and 8; Ament, Zirr and
-// Dachsbacher 2017 blend them in the volume): the Henyey–Greenstein phase function (Henyey and
-// Greenstein 1941) and the normalised Blinn–Phong BRDF (Blinn 1977; normalised as in Akenine-
-// Möller, Haines and Hoffman, Real-Time Rendering). Each takes its per-launch constants once and
-// evaluates with a square-root and power function of the caller's choice: the ray marcher passes
-// its fast host forms (kernels/ray_fast_math.h), surface shading the library's; test_shading holds
-// both to the closed forms.
+// The renderer's two scattering functions, written once (Himmler & Günther 2026, Eqs. 5 and 8;
+// Ament, Zirr and Dachsbacher 2017 blend them in the volume): the Henyey–Greenstein phase function
+// (Henyey and Greenstein 1941) and the normalised Blinn–Phong BRDF (Blinn 1977; normalised as in
+// Akenine- Möller, Haines and Hoffman, Real-Time Rendering). Each takes its per-launch constants
+// once and evaluates with a square-root and power function of the caller's choice: the ray marcher
+// passes its fast host forms (kernels/ray_fast_math.h), surface shading the library's; test_shading
+// holds both to the closed forms.
 #pragma once
 
 #include <cmath>

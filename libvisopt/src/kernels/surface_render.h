@@ -1,5 +1,5 @@
-// What the ray marcher needs to draw context surfaces (paper 000 Eq. 8, §III-E) and the
-// comparison baselines (Fig. 10), grouped so the volume-only path carries one small struct.
+// What the ray marcher needs to draw context surfaces (Himmler & Günther 2026, Eq. 8, §III-E) and
+// the comparison baselines (Fig. 10), grouped so the volume-only path carries one small struct.
 #pragma once
 
 #include <glm/glm.hpp>

@@ -1,4 +1,5 @@
-// Shading of the context surfaces (paper 000 Eq. 8 and §III-E): the reduced surface radiance
+// Shading of the context surfaces (Himmler & Günther 2026, Eq. 8 and §III-E): the reduced surface
+// radiance
 //   L_r = T_V f_r (n . wL)+ L_i,  L_i = T_L L_e  (Eq. 9),
 // with the normalised Blinn-Phong BRDF f_r of kernels/shading.h, ambient occlusion from the SDF and
 // from the volume. The deviation view's colormaps live in core/colormap_eval.h.

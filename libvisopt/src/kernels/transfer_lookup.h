@@ -1,5 +1,5 @@
-// Post-classification: the transfer function is applied to the interpolated scalar (paper 000
-// Eq. 3: albedo a(x) and base extinction mu_bar(x) from the scalar s(x)).
+// Post-classification: the transfer function is applied to the interpolated scalar (Himmler &
+// Günther 2026 Eq. 3: albedo a(x) and base extinction mu_bar(x) from the scalar s(x)).
 #pragma once
 
 #include <glm/glm.hpp>

@@ -1,10 +1,10 @@
-// Front-to-back transmittance along the rays of a frustum grid (paper 000 Eqs. 4-5):
+// Front-to-back transmittance along the rays of a frustum grid (Himmler & Günther 2026, Eqs. 4-5):
 // T(s) = exp(-integral from the eye to s of mu). One ray per (i, j), cells k front to back.
 // Each cell [s_k - ds/2, s_k + ds/2] contributes mu times the length of its overlap with the
 // volume's box, sampled at the overlap's midpoint, so a sharp box boundary costs no error.
 //
 // Two discretisations are offered:
-//  - Exclusive: T_k = exp(-sum_{j<k} tau_j), the discrete energy's definition (METHODS.md §1),
+//  - Exclusive: T_k = exp(-sum_{j<k} tau_j), the discrete energy's definition (docs/methods.md §1),
 //  - Midpoint:  T_k = exp(-(sum_{j<k} tau_j + tau_k / 2)), the value at the cell centre, which
 //    is what the renderer interpolates (second-order accurate for lookups).
 #pragma once

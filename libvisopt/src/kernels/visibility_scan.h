@@ -1,5 +1,5 @@
-// Grid updates of the extinction optimisation (paper 000 Eqs. 10-13; METHODS.md §1) along the
-// rays of a view- or light-space frustum grid.
+// Grid updates of the extinction optimisation (Himmler & Günther 2026, Eqs. 10-13; docs/methods.md
+// §1) along the rays of a view- or light-space frustum grid.
 //
 // The discrete energy (the ground truth the gradient is checked against) is
 //   E = rho/2 sum_v (mu_v - mubar_v)^2 dV  -  q sum_c g_c mu_c T_c dV_c  -  r (same on the light
@@ -16,11 +16,11 @@
 // either backend. Each ray also returns its contributions to the energy and to the
 // importance-weighted visibility V = sum g mu T dV / sum g mu dV.
 //
-// Context surfaces (paper 000 §III) are opaque: from the first cell inside their union (phi < 0)
-// on, T = 0, so the volume behind a surface is neither seen nor lit and gets no derivative.
-// View rays may carry screen-space weights (lens, windowing masks: Fig. 8) that multiply g.
-// When `behindMax` is given, the backward pass also stores the running maximum of g strictly
-// behind each cell — half of ghat in Eq. 19.
+// Context surfaces (Himmler & Günther 2026, §III) are opaque: from the first cell inside their
+// union (phi < 0) on, T = 0, so the volume behind a surface is neither seen nor lit and gets no
+// derivative. View rays may carry screen-space weights (lens, windowing masks: Fig. 8) that
+// multiply g. When `behindMax` is given, the backward pass also stores the running maximum of g
+// strictly behind each cell — half of ghat in Eq. 19.
 #pragma once
 
 #include <cmath>

@@ -1,7 +1,8 @@
-// The grid updates of visibility_scan.h (paper 000 Eqs. 10-13), arranged for speed. The same
-// inputs, the same two passes per ray and the same results to float round-off; VisibilityScan
-// stays as the reference the tests compare this kernel against. What differs (profile of the
-// default scene: the reference scan was 54 % of the run, its trilinear samples the bulk of it):
+// The grid updates of visibility_scan.h (Himmler & Günther 2026, Eqs. 10-13), arranged for speed.
+// The same inputs, the same two passes per ray and the same results to float round-off;
+// VisibilityScan stays as the reference the tests compare this kernel against. What differs
+// (profile of the default scene: the reference scan was 54 % of the run, its trilinear samples the
+// bulk of it):
 //
 // - One set of trilinear corners per cell serves mu, g, the product g mu of the occluder
 //   statistic and every surface's phi (the reference finds the corners four times, and reloads

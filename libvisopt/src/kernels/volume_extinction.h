@@ -1,6 +1,6 @@
 // Extinction mu_t at a continuous index position inside the volume: the transfer function's
-// base extinction mu_bar(s(x)) (paper 000 Eq. 3), plus the optimisation's change to it when
-// there is one (see extinctionWithChange).
+// base extinction mu_bar(s(x)) (Himmler & Günther 2026, Eq. 3), plus the optimisation's change to
+// it when there is one (see extinctionWithChange).
 #pragma once
 
 #include <glm/glm.hpp>

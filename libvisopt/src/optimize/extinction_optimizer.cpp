@@ -287,7 +287,7 @@ void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
 }
 
 // Substeps of the level-set step per iteration on `level` (LevelSetSettings::reach).
-// The lens and windowing mask of the view rays (paper 000 §III-F, Fig. 8).
+// The lens and windowing mask of the view rays (Himmler & Günther 2026, §III-F, Fig. 8).
 ScreenWeights screenWeightsOf(const OptimizationInputs& in) {
   ScreenWeights weights;
   if (in.lens.radius > 0.f) {
@@ -532,7 +532,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
   const int tBeta3 = s.beta3Warmup > 0 ? s.beta3Warmup : cap;
   c.alpha = s.alpha * std::min(1.f, float(t) / float(std::max(tAlpha, 1)));
   if (t < tBeta3) {
-    // Linear interpolation in half-life space from beta1 to beta3 (METHODS.md §2).
+    // Linear interpolation in half-life space from beta1 to beta3 (docs/methods.md §2).
     auto halfLife = [](float b) { return std::log(0.5f) / std::log(b) - 1.f; };
     const float f = float(t) / float(tBeta3);
     const float hl = (1.f - f) * halfLife(s.beta1) + f * halfLife(s.beta3);

@@ -1,5 +1,6 @@
-// Host orchestration of the extinction optimisation (paper 000 §II-C, Eqs. 10-14): the level
-// loop of the coarse-to-fine multigrid, the frustum grids, the optimiser state, statistics.
+// Host orchestration of the extinction optimisation (Himmler & Günther 2026, §II-C, Eqs. 10-14):
+// the level loop of the coarse-to-fine multigrid, the frustum grids, the optimiser state,
+// statistics.
 #pragma once
 
 #include <functional>

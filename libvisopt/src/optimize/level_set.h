@@ -1,6 +1,7 @@
-// Host orchestration of the context-surface numerics (paper 000 §III-B-D; METHODS.md §3):
-// the level-set step of Eq. 23, redistancing (Eq. 18), an SDF from an isovalue, thin shells
-// (Eq. 26). Fields are fp32 or fp16 (each Field3D's own precision); arithmetic is fp32.
+// Host orchestration of the context-surface numerics (Himmler & Günther 2026, §III-B-D;
+// docs/methods.md §3): the level-set step of Eq. 23, redistancing (Eq. 18), an SDF from an
+// isovalue, thin shells (Eq. 26). Fields are fp32 or fp16 (each Field3D's own precision);
+// arithmetic is fp32.
 #pragma once
 
 #include "visopt/field.h"

@@ -1,6 +1,6 @@
-// The core scenario of paper 000 (Fig. 3) in volume form: a dense wall of unimportant matter
-// stands between the camera and an optically thin important disc (a "membrane"), which it hides
-// completely at first.
+// The core scenario of Himmler & Günther 2026 (Fig. 3) in volume form: a dense wall of unimportant
+// matter stands between the camera and an optically thin important disc (a "membrane"), which it
+// hides completely at first.
 //
 // Why a thin disc: the energy rewards g mu T_V (Eq. 12), so inside an important structure the
 // optimisation raises mu towards mu_max, and a thick structure then shades its own back; its

@@ -37,7 +37,8 @@ const Entry kScenes[] = {
      "CT-like head: the skin isosurface hides a thick skull (marked important) under soft tissue",
      &scenes::makeCtHead},
     {"occluded-blob",
-     "Paper 000 Fig. 3: a dense wall hides an optically thin important disc behind it",
+     "Himmler & Günther 2026, Fig. 3: a dense wall hides an optically thin important disc behind "
+     "it",
      &scenes::makeOccludedBlob},
 };
 

@@ -1,6 +1,7 @@
-// Side-by-side comparison of N labelled renderings (paper 000 Fig. 10: ours, maximum importance
-// projection, cut-away, transparency modulation): one row for up to three, a 2x2 grid for four,
-// a near-square grid beyond. Each image is scaled to fit its cell with its aspect ratio kept.
+// Side-by-side comparison of N labelled renderings (Himmler & Günther 2026, Fig. 10: ours, maximum
+// importance projection, cut-away, transparency modulation): one row for up to three, a 2x2 grid
+// for four, a near-square grid beyond. Each image is scaled to fit its cell with its aspect ratio
+// kept.
 #pragma once
 
 #include <utility>

@@ -1,7 +1,7 @@
-// The context surfaces (paper 000 §III): a list with visibility, colour and representation, and
-// a dialog that states a new surface as a ContextSurfaceSpec (an isosurface of the data, a mesh
-// file or a .vdb level set; filled or a thin shell). The panel changes nothing itself: it emits
-// requests, and the engine's surfaces come back through setSurfaces.
+// The context surfaces (Himmler & Günther 2026, §III): a list with visibility, colour and
+// representation, and a dialog that states a new surface as a ContextSurfaceSpec (an isosurface of
+// the data, a mesh file or a .vdb level set; filled or a thin shell). The panel changes nothing
+// itself: it emits requests, and the engine's surfaces come back through setSurfaces.
 #pragma once
 
 #include <functional>

@@ -1,5 +1,5 @@
-// The deviation view (paper 000 Fig. 5): context surfaces coloured by how far the optimisation
-// moved them from their original shape, |phi0| at the surface, through a colormap over
+// The deviation view (Himmler & Günther 2026, Fig. 5): context surfaces coloured by how far the
+// optimisation moved them from their original shape, |phi0| at the surface, through a colormap over
 // [0, max deviation]. The panel edits the view's settings; DeviationLegend shows the colour bar.
 #pragma once
 

@@ -1,6 +1,7 @@
-// The optimisation panel: a form over ExtinctionSettings and LevelSetSettings (paper 000 Eqs.
-// 10-14 and 23), the storage precision, and the run / freeze / restart controls. It holds no
-// numerics: every edit emits the complete settings, which the main window passes to the engine.
+// The optimisation panel: a form over ExtinctionSettings and LevelSetSettings (Himmler & Günther
+// 2026, Eqs. 10-14 and 23), the storage precision, and the run / freeze / restart controls. It
+// holds no numerics: every edit emits the complete settings, which the main window passes to the
+// engine.
 #pragma once
 
 #include <QMetaType>

@@ -1,7 +1,7 @@
-// The importance lens (paper 000 §III-F): while the tool is active the lens follows the cursor;
-// the wheel changes its radius, Shift+wheel its strength; a left click or Escape switches it off
-// (radius 0), a left click or the wheel switches it on again. lensChanged is emitted once per
-// change of the effective lens, not while a switched-off lens follows the cursor.
+// The importance lens (Himmler & Günther 2026, §III-F): while the tool is active the lens follows
+// the cursor; the wheel changes its radius, Shift+wheel its strength; a left click or Escape
+// switches it off (radius 0), a left click or the wheel switches it on again. lensChanged is
+// emitted once per change of the effective lens, not while a switched-off lens follows the cursor.
 #pragma once
 
 #include <QPointF>

@@ -1,6 +1,6 @@
-// Editing logic of the world-space mask (paper 000 §III-F, R5): a bit mask on the volume grid
-// painted with a sphere brush in world units, in strokes that can be cancelled, undone and
-// redone. No widgets: MaskPaintTool drives it from the mouse, tests drive it with world points.
+// Editing logic of the world-space mask (Himmler & Günther 2026, §III-F, R5): a bit mask on the
+// volume grid painted with a sphere brush in world units, in strokes that can be cancelled, undone
+// and redone. No widgets: MaskPaintTool drives it from the mouse, tests drive it with world points.
 // The mask goes to the engine as it is (Engine::setWorldMask takes the bit mask).
 #pragma once
 

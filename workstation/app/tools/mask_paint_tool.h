@@ -1,6 +1,6 @@
-// The world-mask brush (paper 000 §III-F, R5): left drag paints the mask where the cursor's ray
-// hits the scene (pickWorldPoint), Ctrl held (or erase mode) erases, Escape cancels the stroke
-// in progress. One undo entry per stroke.
+// The world-mask brush (Himmler & Günther 2026, §III-F, R5): left drag paints the mask where the
+// cursor's ray hits the scene (pickWorldPoint), Ctrl held (or erase mode) erases, Escape cancels
+// the stroke in progress. One undo entry per stroke.
 #pragma once
 
 #include <memory>

@@ -1,6 +1,6 @@
-// The screen-space windowing mask (paper 000 §III-F, Fig. 8): the user paints, over the image,
-// where the importance along the view rays is masked, so the context in front of the important
-// structures is kept there as a depth cue.
+// The screen-space windowing mask (Himmler & Günther 2026, §III-F, Fig. 8): the user paints, over
+// the image, where the importance along the view rays is masked, so the context in front of the
+// important structures is kept there as a depth cue.
 //
 // The tool holds a coverage raster c in [0, 1] (rasterWidth x rasterHeight over the whole image,
 // row 0 at the top) painted with a soft round brush: a drag raises coverage, a Ctrl-drag lowers

@@ -168,3 +168,33 @@ TEST(SurfaceRendering, TheFourMethodsDiffer) {
     for (size_t b = a + 1; b < images.size(); ++b)
       EXPECT_LT(psnr(images[a], images[b]), 45.0) << a << " vs " << b;
 }
+
+// Volume ambient occlusion (ray_march.h): the ambient light on a surface is dimmed by the
+// transmittance through the volume along its normal over the AO radius, exp(-mu R), times the
+// SDF's own occlusion (1 for a convex sphere). Lit from behind, the centre of the disc receives
+// ambient light only, so the ratio of the renders with and without AO is exactly that factor; the
+// fog is black (albedo 0), so it adds no light of its own.
+TEST(SurfaceRendering, VolumeAmbientOcclusionIsTheTransmittanceAlongTheNormal) {
+  Engine e;
+  sphereScene(e, 33, 10.f, glm::vec3(0.8f));
+  const float mu = 0.05f;
+  e.setTransferFunction(constantTransferFunction(mu, glm::vec3(0.f)));
+  PointLight behind = e.light();
+  behind.position = -e.camera().eye;  // the visible hemisphere faces away from it
+  e.setLight(behind);
+  RenderSettings rs = surfaceOnly(33);
+  rs.ambient = 0.4f;
+  rs.ambientOcclusionRadius = 6.f;  // voxels of unit spacing: 6 world units
+  const float without = e.render(rs).at(16, 16).x;
+  rs.ambientOcclusion = true;
+  const float with = e.render(rs).at(16, 16).x;
+  ASSERT_GT(without, 0.01f) << "the ambient light reaches the surface";
+  const float expected = std::exp(-mu * 6.f);  // 0.741
+  EXPECT_NEAR(with / without, expected, 0.01f);
+  // Without fog there is nothing to occlude: the sphere alone leaves the ambient as it is.
+  e.setTransferFunction(constantTransferFunction(0.f, glm::vec3(0.f)));
+  rs.ambientOcclusion = false;
+  const float clearWithout = e.render(rs).at(16, 16).x;
+  rs.ambientOcclusion = true;
+  EXPECT_NEAR(e.render(rs).at(16, 16).x / clearWithout, 1.f, 0.005f);
+}

@@ -198,3 +198,82 @@ TEST(SurfaceRendering, VolumeAmbientOcclusionIsTheTransmittanceAlongTheNormal) {
   rs.ambientOcclusion = true;
   EXPECT_NEAR(e.render(rs).at(16, 16).x / clearWithout, 1.f, 0.005f);
 }
+
+// The comparison baselines of Fig. 10 against what their definitions predict, on a context
+// sphere (colour C) that hides an important bar (g = 1, opaque, albedo A) inside it, lit only by
+// ambient light a (so a surface shows 3 a C, an opaque volume sample a A): ghat is ~1 on the
+// sphere's front over the bar and 0 beside it.
+// - Maximum importance projection: every pixel whose ray meets the bar shows the bar's sample,
+//   a A, whatever lies in front.
+// - Cut-away: where ghat > 0.3 the front is gone and the bar shows (a A); beside the bar the
+//   sphere stays (3 a C).
+// - Transparency modulation: the front's alpha is 1 - ghat: ~0 over the bar, 1 beside it.
+TEST(SurfaceRendering, TheBaselinesShowWhatTheirDefinitionsPredict) {
+  const int n = 33;
+  Engine e;
+  Volume v = homogeneousCube(n);
+  const GridSpec g = v.grid();
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const glm::vec3 x = g.indexToWorld(glm::vec3(float(i), float(j), float(k)));
+        const bool bar = std::abs(x.x) <= 3.f && std::abs(x.y) <= 3.f && std::abs(x.z) <= 3.f;
+        v.normalized.set(g.linearIndex(i, j, k), bar ? 1.f : 0.f);
+      }
+  e.setVolume(std::move(v));
+  const glm::vec3 albedo(0.9f, 0.2f, 0.1f), colour(0.2f, 0.5f, 0.8f);
+  TransferFunction tf;
+  tf.unitDistance = 1.f;
+  tf.opacity = {{0.0, 0.f}, {0.5, 0.f}, {1.0, 1.f - std::exp(-5.f)}};  // mu 5 per unit in the bar
+  tf.color = {{0.0, albedo}, {1.0, albedo}};
+  e.setTransferFunction(tf);
+  e.setImportanceCurve({{0.0, 0.0}, {0.5, 0.0}, {1.0, 1.0}});
+  const Camera cam = Camera::orbit({0, 0, 0}, 0.f, 0.f, 100.f);
+  e.setCamera(cam);
+  PointLight light;
+  light.position = cam.eye;  // the light half of ghat sees what the view half sees
+  light.intensity = 0.f;     // ambient light only
+  e.setLight(light);
+  ContextSurfaceSpec spec;
+  spec.source = "test:sphere";
+  spec.color = colour;
+  e.addContextSurface(spec, sphereSdf(g, glm::vec3(0.f), 10.f));
+  e.setViewportSize(65, 65);
+  ExtinctionSettings s;
+  s.levels = 1;
+  s.maxIterationsPerLevel = 5;
+  e.setExtinctionSettings(s);
+  e.optimize();  // leaves ghat (Eq. 19) behind
+  ASSERT_NE(e.importanceBehind(), nullptr);
+
+  const int size = 65;  // the disc of the sphere is ~22 pixels wide, the bar ~7
+  RenderSettings rs = surfaceOnly(size);
+  rs.ambient = 0.5f;
+  rs.stepFactor = 0.25f;
+  const glm::vec3 bar = 0.5f * albedo, sphere = 3.f * 0.5f * colour;
+  auto near = [](glm::vec3 got, glm::vec3 want, float tol, const char* what) {
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(got[c], want[c], tol * want[c] + 2e-3f)
+          << what << ", channel " << c << ": (" << got.x << " " << got.y << " " << got.z << ")";
+  };
+  const int centre = size / 2, beside = size / 2 + 7;  // ~6 units right: on the disc, off the bar
+
+  rs.method = RenderMethod::MaxImportanceProjection;
+  const Image mip = e.render(rs);
+  near(mip.at(centre, centre), bar, 0.02f, "max. importance, over the bar");
+
+  rs.method = RenderMethod::CutAway;
+  const Image cut = e.render(rs);
+  near(cut.at(centre, centre), bar, 0.03f, "cut-away, over the bar");
+  near(cut.at(beside, centre), sphere, 0.03f, "cut-away, beside the bar");
+
+  rs.method = RenderMethod::TransparencyModulation;
+  const Image transparent = e.render(rs);
+  near(transparent.at(centre, centre), bar, 0.05f, "transparency, over the bar");
+  near(transparent.at(beside, centre), sphere, 0.03f, "transparency, beside the bar");
+
+  // The unoptimised scene for contrast: the sphere everywhere on the disc.
+  rs.method = RenderMethod::Optimized;
+  e.setRenderOptimized(false);
+  near(e.render(rs).at(centre, centre), sphere, 0.03f, "the sphere in front of the bar");
+}

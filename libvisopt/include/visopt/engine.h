@@ -14,6 +14,7 @@
 #include "visopt/context_surface.h"
 #include "visopt/exec.h"
 #include "visopt/image.h"
+#include "visopt/importance_kind.h"
 #include "visopt/level_set.h"
 #include "visopt/memory_ledger.h"
 #include "visopt/optimization.h"
@@ -65,7 +66,8 @@ class Engine {
   const Field3D* importance() const;
   // Where the importance came from, so a session can rebuild it.
   struct ImportanceSource {
-    enum class Kind { None, Scene, Curve, Volume } kind = Kind::None;
+    using Kind = ImportanceKind;
+    Kind kind = Kind::None;
     std::vector<glm::dvec2> curve;  // Kind::Curve: (value, g) points in data units
     std::string path;               // Kind::Volume: the file
   };

@@ -23,6 +23,7 @@
 #include "visopt/bit_mask.h"
 #include "visopt/camera.h"
 #include "visopt/engine.h"
+#include "visopt/importance_kind.h"
 #include "visopt/level_set.h"
 #include "visopt/optimization.h"
 #include "visopt/precision.h"
@@ -82,13 +83,11 @@ DataResolution resolveDataReference(const DataReference& ref, const std::string&
 using SessionMask = BitMask;
 
 struct SessionImportance {
-  enum class Kind { None, Scene, Curve, Volume } kind = Kind::None;
+  using Kind = ImportanceKind;  // the engine's ImportanceSource::Kind too
+  Kind kind = Kind::None;
   std::vector<glm::dvec2> curve;  // Curve: (value, g) in data units
   DataReference volume;           // Volume: the importance file
 };
-
-// "none", "scene", "curve" or "volume": the names the session format uses.
-const char* toString(SessionImportance::Kind kind);
 
 struct SessionSurface {
   ContextSurfaceSpec spec;  // as the user gave it ("mesh:/old/place.obj")

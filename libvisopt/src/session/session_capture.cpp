@@ -27,21 +27,10 @@ Session captureSession(const Engine& engine, const RenderSettings& render,
   s.transferFunction = engine.transferFunction();
 
   const Engine::ImportanceSource& imp = engine.importanceSource();
-  switch (imp.kind) {
-    case Engine::ImportanceSource::Kind::None:
-      break;
-    case Engine::ImportanceSource::Kind::Scene:
-      s.importance.kind = SessionImportance::Kind::Scene;
-      break;
-    case Engine::ImportanceSource::Kind::Curve:
-      s.importance.kind = SessionImportance::Kind::Curve;
-      s.importance.curve = imp.curve;
-      break;
-    case Engine::ImportanceSource::Kind::Volume:
-      s.importance.kind = SessionImportance::Kind::Volume;
-      s.importance.volume = makeDataReference(imp.path, sessionPath);
-      break;
-  }
+  s.importance.kind = imp.kind;  // one enum for both
+  if (imp.kind == ImportanceKind::Curve) s.importance.curve = imp.curve;
+  if (imp.kind == ImportanceKind::Volume)
+    s.importance.volume = makeDataReference(imp.path, sessionPath);
 
   for (const ContextSurfaceSpec& spec : engine.contextSurfaces()) {
     SessionSurface surface{spec, {}};

@@ -2,6 +2,8 @@
 
 #include <QFileInfo>
 
+#include <visopt/context_surface.h>
+
 namespace visopt::ws {
 
 CommandLineFiles sortCommandLineFiles(const QStringList& paths) {
@@ -12,11 +14,11 @@ CommandLineFiles sortCommandLineFiles(const QStringList& paths) {
     const bool isDir = QFileInfo(path).isDir();
     if (!isDir && (suffix == QLatin1String("ply") || suffix == QLatin1String("obj") ||
                    suffix == QLatin1String("off") || suffix == QLatin1String("stl"))) {
-      files.surfaces << QStringLiteral("mesh:") + path;
+      files.surfaces << QString::fromStdString(SurfaceSource::mesh(path.toStdString()).format());
       continue;
     }
     if (!isDir && suffix == QLatin1String("vdb")) {
-      files.surfaces << QStringLiteral("vdb:") + path;
+      files.surfaces << QString::fromStdString(SurfaceSource::vdb(path.toStdString()).format());
       continue;
     }
     if (!scene.isEmpty()) {

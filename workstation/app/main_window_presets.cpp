@@ -4,6 +4,7 @@
 // `--tf preset:ct-skin-bone --context iso:-400` and this menu entry set up the same scene.
 #include <visopt/context_surface.h>
 #include <visopt/engine.h>
+#include <visopt/error.h>
 #include <visopt/transfer_function.h>
 
 #include <QStatusBar>
@@ -16,7 +17,17 @@ namespace visopt::ws {
 
 namespace {
 constexpr const char* kCtPreset = "ct-skin-bone";
+
+// The same surface whatever the text says ("iso:-400" from an older session and
+// "iso:-400:inside-high" are one); text that is no source is no match.
+bool sameSource(const std::string& text, const SurfaceSource& source) {
+  try {
+    return SurfaceSource::parse(text) == source;
+  } catch (const Error&) {
+    return false;
+  }
 }
+}  // namespace
 
 void MainWindow::applyImportanceCurve(const std::vector<glm::dvec2>& curve,
                                       const std::string& origin) {
@@ -70,12 +81,13 @@ void MainWindow::useSkinAsContextBoneAsImportance() {
   if (presetIndex > 0 && tfEditor_->applyPreset(presetIndex)) tfEditor_->flushPendingEdit();
   applyImportanceCurve(TransferFunction::presetImportance(kCtPreset),
                        std::string("preset:") + kCtPreset);
+  const SurfaceSource skinSource = SurfaceSource::iso(skin);
   const ContextSurfaceSpec spec =
-      defaultContextSurfaceSpec("iso:" + QString::number(skin).toStdString(), snap->volume->grid());
+      defaultContextSurfaceSpec(skinSource.format(), snap->volume->grid());
   controller_->postLong(tr("Context surface %1").arg(QString::fromStdString(spec.source)),
-                        [this, spec](Engine& e, const ProgressCallback& progress) {
+                        [this, spec, skinSource](Engine& e, const ProgressCallback& progress) {
                           for (const ContextSurfaceSpec& have : e.contextSurfaces())
-                            if (have.source == spec.source) return;  // already the context
+                            if (sameSource(have.source, skinSource)) return;  // already there
                           e.addContextSurface(spec, progress);
                           controller_->refreshSnapshot(e);
                         });

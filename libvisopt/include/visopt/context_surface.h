@@ -21,6 +21,28 @@ struct ContextSurfaceSpec {
   bool visible = true;
 };
 
+// A context surface's source, typed, and its text form as ContextSurfaceSpec::source, sessions
+// and the CLI's --context write it: "iso:VALUE[:inside-high|inside-low]" (an isosurface of the
+// data; inside-high, the default: values above VALUE are inside), "mesh:FILE" or "vdb:FILE".
+struct SurfaceSource {
+  enum class Kind { Iso, Mesh, Vdb };
+  Kind kind = Kind::Iso;
+  double isoValue = 0.0;   // Iso
+  bool insideHigh = true;  // Iso
+  std::string file;        // Mesh, Vdb
+
+  static SurfaceSource iso(double value, bool insideHigh = true);
+  static SurfaceSource mesh(std::string file);
+  static SurfaceSource vdb(std::string file);
+  // Throws Error(Usage) naming `text` unless it is one of the forms above, with a finite VALUE
+  // and a FILE that is not empty (everything after the first colon: a path may hold colons).
+  static SurfaceSource parse(const std::string& text);
+  // The text form; VALUE in the shortest form that reads back as the same double.
+  std::string format() const;
+  bool hasFile() const { return kind != Kind::Iso; }
+  bool operator==(const SurfaceSource&) const = default;
+};
+
 // The representation a source gets unless the user chooses: an isosurface of the data
 // ("iso:...") is a thin shell reaching one voxel (the grid's smallest spacing) each side, since
 // the isosurface of a scan bounds a tissue layer (skin, a vessel wall), not a solid: filled, a

@@ -1,21 +1,33 @@
 #include "session/surface_source.h"
 
+#include "visopt/context_surface.h"
+#include "visopt/error.h"
+
 namespace visopt::session {
 
 namespace {
-bool hasFile(const std::string& source) {
-  return source.rfind("mesh:", 0) == 0 || source.rfind("vdb:", 0) == 0;
+// The typed source, or nothing for text that is not a source with a file (iso:, or malformed:
+// the engine reports that when it builds the surface).
+std::optional<SurfaceSource> withFile(const std::string& source) {
+  try {
+    SurfaceSource s = SurfaceSource::parse(source);
+    if (s.hasFile()) return s;
+  } catch (const Error&) {
+  }
+  return std::nullopt;
 }
 }  // namespace
 
 std::optional<std::string> surfaceFile(const std::string& source) {
-  if (!hasFile(source)) return std::nullopt;
-  return source.substr(source.find(':') + 1);
+  if (auto s = withFile(source)) return s->file;
+  return std::nullopt;
 }
 
 std::string withSurfaceFile(const std::string& source, const std::string& file) {
-  if (!hasFile(source)) return source;
-  return source.substr(0, source.find(':') + 1) + file;
+  auto s = withFile(source);
+  if (!s) return source;
+  s->file = file;
+  return s->format();
 }
 
 }  // namespace visopt::session

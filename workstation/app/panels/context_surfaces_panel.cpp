@@ -28,6 +28,8 @@
 #include <QToolButton>
 #include <QVBoxLayout>
 
+#include <visopt/error.h>
+
 namespace visopt::ws {
 
 namespace {
@@ -43,12 +45,6 @@ float encodeSrgb(float linear) {
 float decodeSrgb(float encoded) {
   const float c = std::clamp(encoded, 0.f, 1.f);
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
-std::string shortestNumber(double value) {
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
 }
 
 // Decimals for a spin box over a range of this width: about five significant digits.
@@ -90,14 +86,13 @@ ContextSurfaceSpec makeSurfaceSpec(const SurfaceSourceFields& fields) {
   ContextSurfaceSpec spec;
   switch (fields.kind) {
     case SurfaceSourceFields::Kind::Iso:
-      spec.source = "iso:" + shortestNumber(fields.isoValue) +
-                    (fields.insideHigh ? ":inside-high" : ":inside-low");
+      spec.source = SurfaceSource::iso(fields.isoValue, fields.insideHigh).format();
       break;
     case SurfaceSourceFields::Kind::Mesh:
-      spec.source = "mesh:" + fields.file.trimmed().toStdString();
+      spec.source = SurfaceSource::mesh(fields.file.trimmed().toStdString()).format();
       break;
     case SurfaceSourceFields::Kind::Vdb:
-      spec.source = "vdb:" + fields.file.trimmed().toStdString();
+      spec.source = SurfaceSource::vdb(fields.file.trimmed().toStdString()).format();
       break;
   }
   spec.filled = fields.filled;
@@ -106,21 +101,26 @@ ContextSurfaceSpec makeSurfaceSpec(const SurfaceSourceFields& fields) {
 }
 
 QString describeSurfaceSource(const std::string& source) {
-  const QString text = QString::fromStdString(source);
-  if (text.startsWith(QLatin1String("iso:"))) {
-    const QStringList parts = text.mid(4).split(QLatin1Char(':'));
-    const QString side = parts.size() > 1 && parts[1] == QLatin1String("inside-low")
-                             ? QObject::tr("inside low")
-                             : QObject::tr("inside high");
-    return QObject::tr("iso %1 (%2)").arg(parts.value(0), side);
+  SurfaceSource s;
+  try {
+    s = SurfaceSource::parse(source);
+  } catch (const Error&) {
+    return QString::fromStdString(source);  // shown as it is; building it reports the error
   }
-  for (const char* prefix : {"mesh", "vdb"}) {
-    const QString p = QString::fromLatin1(prefix) + QLatin1Char(':');
-    if (text.startsWith(p))
-      return QString::fromLatin1(prefix) + QStringLiteral(": ") +
-             QFileInfo(text.mid(p.size())).fileName();
+  switch (s.kind) {
+    case SurfaceSource::Kind::Iso: {
+      char buffer[64];
+      const auto end = std::to_chars(buffer, buffer + sizeof(buffer), s.isoValue).ptr;
+      return QObject::tr("iso %1 (%2)")
+          .arg(QString::fromLatin1(buffer, int(end - buffer)),
+               s.insideHigh ? QObject::tr("inside high") : QObject::tr("inside low"));
+    }
+    case SurfaceSource::Kind::Mesh:
+      return QStringLiteral("mesh: ") + QFileInfo(QString::fromStdString(s.file)).fileName();
+    case SurfaceSource::Kind::Vdb:
+      return QStringLiteral("vdb: ") + QFileInfo(QString::fromStdString(s.file)).fileName();
   }
-  return text;
+  return QString::fromStdString(source);
 }
 
 QString describeRepresentation(const ContextSurfaceSpec& spec) {

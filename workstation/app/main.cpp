@@ -26,7 +26,9 @@ namespace {
 
 // Drags the camera while the optimisation runs and reports the time from each camera change to
 // the frame that shows it. Each drag is a press, a small orbit and a release, followed by a
-// pause in which the optimisation resumes, so every drag meets an iteration in flight.
+// pause in which the optimisation resumes, so every drag meets an iteration in flight. Then one
+// continuous 3-second drag (previews on screen per second) and its release (the time to the first
+// full-resolution frame of the resting view, and until that view has converged).
 int runLatencyProbe(MainWindow& window, int steps) {
   ViewportWidget* view = window.viewport();
   const auto pump = [](int ms) {
@@ -46,11 +48,42 @@ int runLatencyProbe(MainWindow& window, int steps) {
   }
   window.waitForSettledFrame(60000);
   const LatencyStats s = view->previewLatency();
+
+  // A continuous drag, as a hand does it: a small orbit every 16 ms (a 60 Hz mouse) for 3 s;
+  // how many previews reach the screen per second.
+  int previews = 0;
+  const QMetaObject::Connection counting = QObject::connect(
+      view, &ViewportWidget::frameShown, [&](const FrameInfo& info) { previews += info.preview; });
+  QElapsedTimer drag;
+  drag.start();
+  while (drag.elapsed() < 3000) {
+    view->setCamera(orbitCamera(view->camera(), 0.4f, 0.f), true);
+    pump(16);
+  }
+  const double previewsPerSecond = double(previews) * 1000.0 / double(drag.elapsed());
+  QObject::disconnect(counting);
+  // The release: the time until the optimisation has converged for the resting view and a full
+  // frame shows it.
+  view->setCamera(view->camera(), false);
+  QElapsedTimer rest;
+  rest.start();
+  double restToFullFrameMs = -1.0;  // the first full-resolution frame of the resting view
+  const QMetaObject::Connection full =
+      QObject::connect(view, &ViewportWidget::frameShown, [&](const FrameInfo& info) {
+        if (!info.preview && restToFullFrameMs < 0.0) restToFullFrameMs = double(rest.elapsed());
+      });
+  const bool settled = window.waitForSettledFrame(300000);
+  QObject::disconnect(full);
+  const double restToConvergedMs = settled ? double(rest.elapsed()) : -1.0;
+
   std::printf(
       "{\"latencyProbe\": {\"drags\": %d, \"framesMatched\": %d, \"meanMs\": %.1f, "
-      "\"p95Ms\": %.1f, \"maxMs\": %.1f, \"previewRenderMeanMs\": %.1f}}\n",
-      steps, s.samples, s.meanMs, s.p95Ms, s.maxMs, s.renderMeanMs);
-  return s.samples > 0 ? 0 : 1;
+      "\"p95Ms\": %.1f, \"maxMs\": %.1f, \"previewRenderMeanMs\": %.1f, "
+      "\"previewsPerSecondDuringDrag\": %.1f, \"restToFullFrameMs\": %.0f, "
+      "\"restToConvergedMs\": %.0f}}\n",
+      steps, s.samples, s.meanMs, s.p95Ms, s.maxMs, s.renderMeanMs, previewsPerSecond,
+      restToFullFrameMs, restToConvergedMs);
+  return s.samples > 0 && settled ? 0 : 1;
 }
 
 }  // namespace

@@ -574,38 +574,36 @@ bool MainWindow::exportViewport(const QString& pngPath) {
 // ---- opening data ---------------------------------------------------------------------------
 
 void MainWindow::openBuiltinScene(const QString& name, int resolution) {
-  sceneLoading_ = true;
   const std::string n = name.toStdString();
-  controller_->postLong(tr("Scene builtin:%1").arg(name),
-                        [this, n, resolution](Engine& e, const ProgressCallback&) {
-                          e.loadBuiltinScene(n, resolution, true);
-                          e.resetOptimization();
-                          controller_->refreshSnapshot(e, true);
-                        });
-  controller_->restartOptimization();
-  sessionPath_.clear();
-  syncPanelsFromEngine();
-  setModified(false);
+  replaceScene(tr("Scene builtin:%1").arg(name),
+               [n, resolution](Engine& e, const ProgressCallback&) {
+                 e.loadBuiltinScene(n, resolution, true);
+               });
 }
 
 void MainWindow::openVolume(const QString& path) {
-  sceneLoading_ = true;
   const std::string p = path.toStdString();
-  controller_->postLong(
-      tr("Volume %1").arg(path), [this, p](Engine& e, const ProgressCallback& progress) {
-        e.loadVolume(p, progress);
-        e.resetOptimization();
-        controller_->refreshSnapshot(e, true);
-        // Accepted with a caveat (DICOM spacing jitter, ...): say so.
-        QStringList warnings;
-        for (const std::string& w : e.volume().warnings) warnings << QString::fromStdString(w);
-        if (!warnings.isEmpty())
-          QMetaObject::invokeMethod(
-              this,
-              // Shown when the long work ends, in place of its "Done".
-              [this, warnings] { loadWarning_ = warnings.join(QStringLiteral("; ")); },
-              Qt::QueuedConnection);
-      });
+  replaceScene(tr("Volume %1").arg(path),
+               [p](Engine& e, const ProgressCallback& progress) { e.loadVolume(p, progress); });
+}
+
+void MainWindow::replaceScene(const QString& title,
+                              std::function<void(Engine&, const ProgressCallback&)> load) {
+  sceneLoading_ = true;
+  controller_->postLong(title, [this, load](Engine& e, const ProgressCallback& progress) {
+    load(e, progress);
+    e.resetOptimization();
+    controller_->refreshSnapshot(e, true);
+    // Accepted with a caveat (DICOM spacing jitter, ...): say so.
+    QStringList warnings;
+    for (const std::string& w : e.volume().warnings) warnings << QString::fromStdString(w);
+    if (!warnings.isEmpty())
+      QMetaObject::invokeMethod(
+          this,
+          // Shown when the long work ends, in place of its "Done".
+          [this, warnings] { loadWarning_ = warnings.join(QStringLiteral("; ")); },
+          Qt::QueuedConnection);
+  });
   controller_->restartOptimization();
   sessionPath_.clear();
   syncPanelsFromEngine();

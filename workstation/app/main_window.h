@@ -118,6 +118,10 @@ class MainWindow : public QMainWindow {
   // The panel layout: every panel tabbed in one column on the right, about a third of the
   // window wide; remembered in the state folder between runs.
   void addSurface(const QString& source, std::function<ContextSurfaceSpec(const Engine&)> specFor);
+  // The one path that replaces the scene (a built-in scene, a volume): `load` runs on the
+  // engine's thread as long work, then the optimisation restarts and the panels follow.
+  void replaceScene(const QString& title,
+                    std::function<void(Engine&, const ProgressCallback&)> load);
   void arrangePanels();
   void showWholeTabTitles();
   int defaultPanelWidth() const;

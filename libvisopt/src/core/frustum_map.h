@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "core/hd.h"
+#include "core/voxel_ijk.h"
 #include "visopt/frustum.h"
 #include "visopt/grid.h"
 
@@ -20,6 +21,8 @@ struct GridMap {
   explicit GridMap(const GridSpec& g)
       : origin(g.origin), spacing(g.spacing), direction(g.direction), dims(g.dims) {}
   VISOPT_HD glm::vec3 toWorld(glm::vec3 ijk) const { return origin + direction * (ijk * spacing); }
+  // The (i, j, k) of linear voxel index v.
+  VISOPT_HD VoxelIjk ijk(int64_t v) const { return voxelIjk(v, dims); }
   VISOPT_HD glm::vec3 toIndex(glm::vec3 p) const {
     return (glm::transpose(direction) * (p - origin)) / spacing;
   }

@@ -54,8 +54,7 @@ struct ExtinctionGradient {
   FrustumFieldView dView, dLight;  // dLight invalid when r == 0
 
   VISOPT_HD VISOPT_INLINE float at(int64_t v, float& mbar) const {
-    const int nx = volume.dims.x, ny = volume.dims.y;
-    const int i = int(v % nx), j = int((v / nx) % ny), k = int(v / (int64_t(nx) * ny));
+    const auto [i, j, k] = volume.ijk(v);
     const glm::vec3 x = volume.toWorld(glm::vec3(float(i), float(j), float(k)));
     mbar = base.at(size_t(v));
     float grad = rho * (mu.load(size_t(v)) - mbar);

@@ -30,6 +30,7 @@
 #include "core/half.h"
 #include "core/hd.h"
 #include "core/min_max.h"
+#include "core/voxel_ijk.h"
 
 namespace visopt {
 
@@ -236,7 +237,7 @@ VISOPT_HD VISOPT_INLINE int spanInteriorEnd(int x1, int nx, int lo) {
 template <class K>
 VISOPT_HD ChangeSums sweepVoxel(const K& k, int64_t v) {
   const int64_t nx = k.dims.x, ny = k.dims.y;
-  const int i = int(v % nx), j = int((v / nx) % ny), l = int(v / (nx * ny));
+  const auto [i, j, l] = voxelIjk(v, k.dims);
   const float c = k.current(size_t(v));
   const float next = k.next(size_t(v), stencilAxis(i, k.dims.x, 1, k.spacing.x),
                             stencilAxis(j, k.dims.y, nx, k.spacing.y),
@@ -433,7 +434,7 @@ struct StepBoundsKernel {
   glm::vec3 spacing{1.f};
   VISOPT_HD StepBounds operator()(int64_t v) const {
     const int64_t nx = dims.x, ny = dims.y;
-    const int i = int(v % nx), j = int((v / nx) % ny), k = int(v / (nx * ny));
+    const auto [i, j, k] = voxelIjk(v, dims);
     const StencilAxis ax = stencilAxis(i, dims.x, 1, spacing.x);
     const StencilAxis ay = stencilAxis(j, dims.y, nx, spacing.y);
     const StencilAxis az = stencilAxis(k, dims.z, nx * ny, spacing.z);

@@ -147,8 +147,7 @@ struct RedistanceKernel {
 struct InterfaceCount {
   FieldView phi;
   VISOPT_HD int64_t operator()(int64_t v) const {
-    const int64_t nx = phi.dims.x, ny = phi.dims.y;
-    const int i = int(v % nx), j = int((v / nx) % ny), k = int(v / (nx * ny));
+    const auto [i, j, k] = voxelIjk(v, phi.dims);
     const float c = phi.load(size_t(v));
     const float xm = phi.at(i > 0 ? i - 1 : i, j, k),
                 xp = phi.at(i + 1 < phi.dims.x ? i + 1 : i, j, k);

@@ -221,8 +221,7 @@ void resample(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   const FieldView from(src), to(dst);
   const GridMap map(dst.grid());
   exec::parallelFor("multigrid resample", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
-    const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-              k = int(v / (int64_t(map.dims.x) * map.dims.y));
+    const auto [i, j, k] = map.ijk(v);
     to.store(size_t(v),
              from.sample(srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))))));
   });
@@ -242,8 +241,7 @@ void resampleMask(const DeviceBitMask& src, const GridMap& srcMap, DeviceBitMask
     for (int bit = 0; bit < 8; ++bit) {
       const int64_t v = b * 8 + bit;
       if (v >= voxels) break;
-      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+      const auto [i, j, k] = map.ijk(v);
       const glm::vec3 p = srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))));
       if (from.sample(p) > 0.5f) word |= 1u << bit;
     }
@@ -260,8 +258,7 @@ void prolongDeviation(const Field3D& phiCoarse, const Field3D& baseCoarse, const
   const FieldView pc(phiCoarse), bc(baseCoarse), bf(baseFine), out(phiFine);
   const GridMap map(phiFine.grid());
   exec::parallelFor("multigrid prolong sdf", int64_t(phiFine.size()), [=] VISOPT_HD(int64_t v) {
-    const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-              k = int(v / (int64_t(map.dims.x) * map.dims.y));
+    const auto [i, j, k] = map.ijk(v);
     const glm::vec3 q = coarse.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))));
     out.store(size_t(v), bf.load(size_t(v)) + (pc.sample(q) - bc.sample(q)));
   });
@@ -274,8 +271,7 @@ void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   const FieldView from(src), to(dst);
   const GridMap map(dst.grid());
   exec::parallelFor("multigrid restrict sdf", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
-    const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-              k = int(v / (int64_t(map.dims.x) * map.dims.y));
+    const auto [i, j, k] = map.ijk(v);
     float m = 3.0e38f;
     for (int c = 0; c < 27; ++c) {
       const glm::vec3 off(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
@@ -360,8 +356,7 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     const GridMap fineMap(fine);
     const glm::vec3 offset = grid.spacing / 3.f;
     exec::parallelFor("multigrid restrict", int64_t(grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
-      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+      const auto [i, j, k] = map.ijk(v);
       float b = 0.f, g = 0.f;
       for (int c = 0; c < 27; ++c) {
         glm::vec3 o(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
@@ -381,8 +376,7 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     FieldView coarse(*level_->mu);
     const GridMap coarseMap(level_->grid);
     exec::parallelFor("multigrid prolong", int64_t(grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
-      const int i = int(v % map.dims.x), j = int((v / map.dims.x) % map.dims.y),
-                k = int(v / (int64_t(map.dims.x) * map.dims.y));
+      const auto [i, j, k] = map.ijk(v);
       glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
       mu.store(size_t(v), coarse.sample(coarseMap.toIndex(x)));
     });

@@ -14,6 +14,7 @@
 
 #include "core/device_bit_mask.h"
 #include "core/field_view.h"
+#include "core/voxel_ijk.h"
 #include "exec/parallel.h"
 #include "kernels/level_set_step.h"
 #include "kernels/redistance.h"
@@ -461,7 +462,7 @@ struct IsoGradientKernel {
   bool everywhere = false;  // all voxels (when none is next to the isosurface)
   VISOPT_HD IsoGradient operator()(int64_t v) const {
     const int64_t nx = s.dims.x, ny = s.dims.y;
-    const int i = int(v % nx), j = int((v / nx) % ny), k = int(v / (nx * ny));
+    const auto [i, j, k] = voxelIjk(v, s.dims);
     const StencilAxis ax = stencilAxis(i, s.dims.x, 1, spacing.x);
     const StencilAxis ay = stencilAxis(j, s.dims.y, nx, spacing.y);
     const StencilAxis az = stencilAxis(k, s.dims.z, nx * ny, spacing.z);

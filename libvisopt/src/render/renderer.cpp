@@ -114,8 +114,7 @@ void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>
     if (same) {
       m = from.load(size_t(v));
     } else {
-      const int i = int(v % voxels.dims.x), j = int((v / voxels.dims.x) % voxels.dims.y),
-                k = int(v / (int64_t(voxels.dims.x) * voxels.dims.y));
+      const auto [i, j, k] = voxels.ijk(v);
       m = from.sample(muGrid.toIndex(voxels.toWorld(glm::vec3(float(i), float(j), float(k)))));
     }
     to.store(size_t(v), m - table.at(scalars.load(size_t(v))).w);

@@ -132,23 +132,34 @@ visopt::ScanSums scan(const K& kernel, int64_t rays) {
       [](const visopt::ScanSums& a, const visopt::ScanSums& b) { return a + b; });
 }
 
-void runCase(benchmark::State& state, const Case& c) {
-  Fields& f = fieldsFor(c.volume, c.precision);
-  const visopt::FrustumGrid frustum = frustumFor(c, f.grid);
-  visopt::GridSpec fg;
-  fg.dims = visopt::frustumStorageDims(frustum.dims);
-  visopt::Field3D out("d", fg, c.precision);
-  std::optional<visopt::Field3D> behind;
+// The scan of `frustum` over the case's fields into `out` (a frustum field in tiled storage).
+visopt::VisibilityScan scanOf(const Fields& f, const visopt::FrustumGrid& frustum,
+                              visopt::Field3D& out) {
   visopt::VisibilityScan s;
   s.frustum = visopt::FrustumMap(frustum);
   s.volume = visopt::GridMap(f.grid);
   s.mu = visopt::FieldView(f.mu);
   s.importance = visopt::FieldView(f.g);
   s.out = visopt::FrustumFieldView(out, frustum.dims);
+  return s;
+}
+
+visopt::Field3D frustumField(const char* name, const visopt::FrustumGrid& frustum, Precision p) {
+  visopt::GridSpec fg;
+  fg.dims = visopt::frustumStorageDims(frustum.dims);
+  return visopt::Field3D(name, fg, p);
+}
+
+void runCase(benchmark::State& state, const Case& c) {
+  Fields& f = fieldsFor(c.volume, c.precision);
+  const visopt::FrustumGrid frustum = frustumFor(c, f.grid);
+  visopt::Field3D out = frustumField("d", frustum, c.precision);
+  std::optional<visopt::Field3D> behind;
+  visopt::VisibilityScan s = scanOf(f, frustum, out);
   if (c.surface) {
     s.surfaces.count = 1;
     s.surfaces.phi[0] = visopt::FieldView(f.phi);
-    behind.emplace("behind max", fg, c.precision);
+    behind.emplace(frustumField("behind max", frustum, c.precision));
     s.behindMax = visopt::FrustumFieldView(*behind, frustum.dims);
   }
   const int64_t rays = int64_t(frustum.dims.x) * frustum.dims.y;
@@ -182,16 +193,8 @@ void runStepCase(benchmark::State& state, int n, int frustumSide, Precision p, b
   Fields& f = fieldsFor(n, p);
   const Case scanCase{Kernel::Tiled, n, frustumSide, p, false};
   const visopt::FrustumGrid frustum = frustumFor(scanCase, f.grid);
-  visopt::GridSpec fg;
-  fg.dims = visopt::frustumStorageDims(frustum.dims);
-  visopt::Field3D d("d", fg, p);
-  visopt::VisibilityScan s;
-  s.frustum = visopt::FrustumMap(frustum);
-  s.volume = visopt::GridMap(f.grid);
-  s.mu = visopt::FieldView(f.mu);
-  s.importance = visopt::FieldView(f.g);
-  s.out = visopt::FrustumFieldView(d, frustum.dims);
-  visopt::scanTilesOnHost("bench scan", s);
+  visopt::Field3D d = frustumField("d", frustum, p);
+  visopt::scanTilesOnHost("bench scan", scanOf(f, frustum, d));
   visopt::Field3D mu("mu", f.grid, p), m1("m1", f.grid, p), m2("m2", f.grid, p),
       rms("rms", f.grid, p);
   for (size_t v = 0; v < mu.size(); ++v) {

@@ -59,8 +59,8 @@ struct RowStep {
       mbar[l] = grad.base.at(v0 + size_t(l));
     }
     // The gradient (ExtinctionGradient::at; a term that is off has d = 0 and adds nothing) and
-    // the optimiser step (OptimizerState::step), vectorised. The sums go to local lanes first:
-    // the caller's arrays might alias the fields as far as the compiler can tell.
+    // the optimiser step (kernels/optimizer_update.h), vectorised. The sums go to local lanes
+    // first: the caller's arrays might alias the fields as far as the compiler can tell.
     double e[kLanes] = {}, s2[kLanes] = {};
     for (int l = 0; l < n; ++l) {
       const size_t v = v0 + size_t(l);
@@ -69,19 +69,7 @@ struct RowStep {
       g -= grad.q * dv[l];
       g -= grad.r * dl[l];
       g = step.gradientScale * g;
-      const float first = c.beta1 * m1.load(v) + (1.f - c.beta1) * g;
-      m1.store(v, first);
-      const float r0 = rms.load(v);
-      const float r = sqrtf(c.beta2 * r0 * r0 + (1.f - c.beta2) * g * g);
-      rms.store(v, r);
-      const float denom = r / c.biasCorrection2 + c.epsilon;
-      float numer = first / c.biasCorrection1;
-      if constexpr (kAdemamix) {
-        const float slow = c.beta3 * m2.load(v) + (1.f - c.beta3) * g;
-        m2.store(v, slow);
-        numer += c.alpha * slow;
-      }
-      const float delta = -c.lr * numer / denom;
+      const float delta = optimizerStep<kAdemamix>(m1, m2, rms, v, g, c);
       const float next = minOf(maxOf(m + delta, 0.f), step.muMax);
       mu.store(v, next);
       const float stored = mu.kept(next);

@@ -24,24 +24,34 @@ struct OptimizerCoefficients {
   float epsilon = 1e-8f;
 };
 
+// The parameter change for gradient g at voxel v, updating the state: AdEMAMix when kAdemamix,
+// Adam otherwise. Fields through any accessor with load/store (FieldView; the CPU rows' typed
+// accessors of core/field_access.h): the one place the update is written.
+template <bool kAdemamix, class A>
+VISOPT_HD VISOPT_INLINE float optimizerStep(const A& m1, const A& m2, const A& rms, size_t v,
+                                            float g, const OptimizerCoefficients& c) {
+  const float m = c.beta1 * m1.load(v) + (1.f - c.beta1) * g;
+  m1.store(v, m);
+  const float r0 = rms.load(v);
+  const float r = sqrtf(c.beta2 * r0 * r0 + (1.f - c.beta2) * g * g);
+  rms.store(v, r);
+  const float denom = r / c.biasCorrection2 + c.epsilon;
+  float numer = m / c.biasCorrection1;
+  if constexpr (kAdemamix) {
+    const float slow = c.beta3 * m2.load(v) + (1.f - c.beta3) * g;  // not bias-corrected
+    m2.store(v, slow);
+    numer += c.alpha * slow;
+  }
+  return -c.lr * numer / denom;
+}
+
 struct OptimizerState {
   FieldView m1, m2, rms;  // m2 only for AdEMAMix
 
   // Returns the parameter change for gradient g at voxel v and updates the state.
   VISOPT_HD VISOPT_INLINE float step(size_t v, float g, const OptimizerCoefficients& c) const {
-    const float m = c.beta1 * m1.load(v) + (1.f - c.beta1) * g;
-    m1.store(v, m);
-    const float r0 = rms.load(v);
-    const float r = sqrtf(c.beta2 * r0 * r0 + (1.f - c.beta2) * g * g);
-    rms.store(v, r);
-    const float denom = r / c.biasCorrection2 + c.epsilon;
-    float numer = m / c.biasCorrection1;
-    if (c.ademamix) {
-      const float slow = c.beta3 * m2.load(v) + (1.f - c.beta3) * g;  // not bias-corrected
-      m2.store(v, slow);
-      numer += c.alpha * slow;
-    }
-    return -c.lr * numer / denom;
+    return c.ademamix ? optimizerStep<true>(m1, m2, rms, v, g, c)
+                      : optimizerStep<false>(m1, m2, rms, v, g, c);
   }
 };
 

@@ -125,6 +125,19 @@ visopt::bench::StreamResult& stream() {
   return s;
 }
 
+// Per iteration: ns per item and core (`perItem`, e.g. "ns_cell_core"), the minimum bytes as
+// GB/s and as a fraction of the probe's triad.
+void setRateCounters(benchmark::State& state, const char* perItem, double items, double bytes) {
+  state.counters[perItem] = benchmark::Counter(
+      items / (1e9 * tbb::info::default_concurrency()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["GBs"] =
+      benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
+  if (stream().triadGBs > 0)
+    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
+                                                benchmark::Counter::kIsIterationInvariantRate);
+}
+
 template <class K>
 visopt::ScanSums scan(const K& kernel, int64_t rays) {
   return visopt::exec::reduce(
@@ -177,14 +190,7 @@ void runCase(benchmark::State& state, const Case& c) {
   const double b = double(visopt::bytesPerValue(c.precision));
   const double bytes = 2.0 * double(f.grid.voxelCount()) * b + cells * b * (c.surface ? 2 : 1);
   state.counters["cells_M"] = cells * 1e-6;
-  state.counters["ns_cell_core"] = benchmark::Counter(
-      cells / (1e9 * tbb::info::default_concurrency()),
-      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-  state.counters["GBs"] =
-      benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  if (stream().triadGBs > 0)
-    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
-                                                benchmark::Counter::kIsIterationInvariantRate);
+  setRateCounters(state, "ns_cell_core", cells, bytes);
   state.counters["V"] = sums.gMu > 0 ? sums.gMuT / sums.gMu : 0.0;
 }
 
@@ -228,14 +234,7 @@ void runStepCase(benchmark::State& state, int n, int frustumSide, Precision p, b
   const double b = double(visopt::bytesPerValue(p));
   const double cells = double(frustum.dims.x) * frustum.dims.y * frustum.dims.z;
   const double bytes = 9.0 * double(voxels) * b + std::min(cells, 8.0 * double(voxels)) * b;
-  state.counters["ns_voxel_core"] = benchmark::Counter(
-      double(voxels) / (1e9 * tbb::info::default_concurrency()),
-      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
-  state.counters["GBs"] =
-      benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  if (stream().triadGBs > 0)
-    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
-                                                benchmark::Counter::kIsIterationInvariantRate);
+  setRateCounters(state, "ns_voxel_core", double(voxels), bytes);
 }
 
 std::vector<Case> cases() {

@@ -267,17 +267,23 @@ void prolongDeviation(const Field3D& phiCoarse, const Field3D& baseCoarse, const
 // Restriction of an SDF to a coarser grid: the minimum over 3^3 points spread over each coarse
 // voxel, so a surface thinner than a coarse voxel (a skull, a thin shell) does not vanish from
 // the coarse levels, where it would otherwise let the view through.
+// The world position of sample c (0..26) of the 3^3 samples that restriction takes in coarse
+// voxel (i, j, k): the voxel's centre and the points a third of a voxel from it along each axis.
+VISOPT_HD VISOPT_INLINE glm::vec3 restrictionSample(const GridMap& coarse, int i, int j, int k,
+                                                    int c) {
+  const glm::vec3 off(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
+  return coarse.toWorld(glm::vec3(float(i), float(j), float(k)) + off / 3.f);
+}
+constexpr int kRestrictionSamples = 27;
+
 void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   const FieldView from(src), to(dst);
   const GridMap map(dst.grid());
   exec::parallelFor("multigrid restrict sdf", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
     const auto [i, j, k] = map.ijk(v);
     float m = 3.0e38f;
-    for (int c = 0; c < 27; ++c) {
-      const glm::vec3 off(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
-      const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)) + off / 3.f);
-      m = fminf(m, from.sample(srcMap.toIndex(x)));
-    }
+    for (int c = 0; c < kRestrictionSamples; ++c)
+      m = fminf(m, from.sample(srcMap.toIndex(restrictionSample(map, i, j, k, c))));
     to.store(size_t(v), m);
   });
 }
@@ -354,20 +360,16 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     FieldView scalars(in.volume->normalized), fineImp(*in.importance);
     TransferLookup tf = lookupOf(in.transfer);
     const GridMap fineMap(fine);
-    const glm::vec3 offset = grid.spacing / 3.f;
     exec::parallelFor("multigrid restrict", int64_t(grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
       const auto [i, j, k] = map.ijk(v);
       float b = 0.f, g = 0.f;
-      for (int c = 0; c < 27; ++c) {
-        glm::vec3 o(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
-        glm::vec3 x =
-            map.toWorld(glm::vec3(float(i), float(j), float(k)) + o * offset / map.spacing);
-        glm::vec3 fi = fineMap.toIndex(x);
+      for (int c = 0; c < kRestrictionSamples; ++c) {
+        const glm::vec3 fi = fineMap.toIndex(restrictionSample(map, i, j, k, c));
         b += tf.at(scalars.sample(fi)).w;
         g += fineImp.sample(fi);
       }
-      base.store(size_t(v), b / 27.f);
-      imp.store(size_t(v), g / 27.f);
+      base.store(size_t(v), b / float(kRestrictionSamples));
+      imp.store(size_t(v), g / float(kRestrictionSamples));
     });
   }
 

@@ -165,6 +165,24 @@ void copyResult(const Field3D& from, Field3D& phi, const Band* band) {
     copyField(from, phi);
 }
 
+// Up to `passes` passes between phi and scratch, each reading one buffer and writing the other,
+// the result back in phi (over the band only when there is one). pass(from, to, n) returns true
+// to stop after pass n. Returns the number of passes run.
+template <class Pass>
+int pingPong(Field3D& phi, Field3D& scratch, int passes, const Band* band, Pass&& pass) {
+  Field3D* from = &phi;
+  Field3D* to = &scratch;
+  int done = 0;
+  for (int n = 0; n < passes; ++n) {
+    const bool stop = pass(*from, *to, n);
+    std::swap(from, to);
+    done = n + 1;
+    if (stop) break;
+  }
+  if (from != &phi) copyResult(*from, phi, band);
+  return done;
+}
+
 void checkOrder(const LevelSetSettings& s) {
   if (s.spatialOrder != 1 && s.spatialOrder != 2)
     throw Error(ErrorKind::Usage, "level set: the spatial order must be 1 or 2");
@@ -349,17 +367,14 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   } else {
     stats.timeStep = levelSetTimeStep(ghat, s);
   }
-  Field3D* from = &phi;
-  Field3D* to = &scratch;
-  for (int n = 0; n < s.substeps; ++n) {
-    const ChangeSums c = substep(*from, phi0, ghat, mask, s, float(stats.timeStep), *to, work);
+  pingPong(phi, scratch, s.substeps, work, [&](const Field3D& from, Field3D& to, int) {
+    const ChangeSums c = substep(from, phi0, ghat, mask, s, float(stats.timeStep), to, work);
     stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
     stats.insideRise = std::max(stats.insideRise, double(c.insideRiseMax));
     stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
     stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
-    std::swap(from, to);
-  }
-  if (from != &phi) copyResult(*from, phi, work);
+    return false;
+  });
   if (!banded) {
     stats.hasInterface = hasInterface(phi);
     return stats;
@@ -424,20 +439,14 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
       mean.idleNear = double(narrow.idleNearVoxels(phi, stopBand * phi.grid().minSpacing()));
     copySpans(phi, scratch, skipFixed ? narrow.workHalo() : narrow.halo());
   }
-  Field3D* from = &phi;
-  Field3D* to = &scratch;
-  for (int n = 0; n < s.redistanceIterations; ++n) {
-    // The first pass also sets the interface band to its subcell distance (kept afterwards).
-    stats.meanSquaredChange = redistancePass(*from, *to, n == 0, s.spatialOrder, base,
-                                             std::max(stopBand, 0.f), work, mean);
-    stats.iterations = n + 1;
-    std::swap(from, to);
-    if (stats.meanSquaredChange < double(s.redistanceTolerance)) {
-      stats.converged = true;
-      break;
-    }
-  }
-  if (from != &phi) copyResult(*from, phi, work);
+  stats.iterations = pingPong(
+      phi, scratch, s.redistanceIterations, work, [&](const Field3D& from, Field3D& to, int n) {
+        // The first pass also sets the interface band to its subcell distance (kept afterwards).
+        stats.meanSquaredChange = redistancePass(from, to, n == 0, s.spatialOrder, base,
+                                                 std::max(stopBand, 0.f), work, mean);
+        stats.converged = stats.meanSquaredChange < double(s.redistanceTolerance);
+        return stats.converged;
+      });
   if (banded) narrow.refresh(phi);
   return stats;
 }
@@ -659,14 +668,10 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
   LevelSetSettings r = s;
   r.redistanceIterations = std::max(s.redistanceIterations, 64);
   r.redistanceTolerance = std::min(s.redistanceTolerance, 1e-6f);
-  Field3D* from = &phi;
-  Field3D* to = &scratch;
-  for (int it = 0; it < r.redistanceIterations; ++it) {
-    const double change = redistancePass(*from, *to, false, r.spatialOrder);
-    std::swap(from, to);
-    if (change < double(r.redistanceTolerance)) break;
-  }
-  if (from != &phi) copyField(*from, phi);
+  pingPong(phi, scratch, r.redistanceIterations, nullptr,
+           [&](const Field3D& from, Field3D& to, int) {
+             return redistancePass(from, to, false, r.spatialOrder) < double(r.redistanceTolerance);
+           });
   return phi;
 }
 

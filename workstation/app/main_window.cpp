@@ -199,7 +199,7 @@ void MainWindow::buildDocks() {
   importanceEditor_->logScaleCheckBox()->setChecked(true);
 
   // One column of tabbed panels on the right (tabs on top, where their titles fit), so the 3D
-  // view keeps most of the window (applyDefaultLayout sizes the column); a panel can be dragged
+  // view keeps most of the window (sizePanelColumn sizes the column); a panel can be dragged
   // out beside the others, and the arrangement is remembered (saveLayout / restoreLayout).
   setTabPosition(Qt::RightDockWidgetArea, QTabWidget::North);
   setDockOptions(dockOptions() | QMainWindow::GroupedDragging);
@@ -932,23 +932,24 @@ void MainWindow::showWholeTabTitles() {
   }
 }
 
-int MainWindow::defaultPanelWidth() const {
+void MainWindow::sizePanelColumn() {
   // About a third of the window, within what the panels' forms need and what leaves the 3D view
   // at least 60 % of a 1280-pixel window.
-  return std::clamp(int(0.38 * double(width())), 340, 520);
+  const int width = std::clamp(int(0.38 * double(this->width())), 340, 520);
+  resizeDocks({panels_.front()}, {width}, Qt::Horizontal);
 }
 
 void MainWindow::resetLayout() {
   comparisonDock_->hide();
   arrangePanels();
-  resizeDocks({panels_.front()}, {defaultPanelWidth()}, Qt::Horizontal);
+  sizePanelColumn();
 }
 
 void MainWindow::showEvent(QShowEvent* event) {
   QMainWindow::showEvent(event);
   if (layoutPlaced_) return;
   layoutPlaced_ = true;
-  if (!restoreLayout()) resizeDocks({panels_.front()}, {defaultPanelWidth()}, Qt::Horizontal);
+  if (!restoreLayout()) sizePanelColumn();
   showWholeTabTitles();
 }
 

@@ -124,7 +124,7 @@ class MainWindow : public QMainWindow {
                     std::function<void(Engine&, const ProgressCallback&)> load);
   void arrangePanels();
   void showWholeTabTitles();
-  int defaultPanelWidth() const;
+  void sizePanelColumn();
   void resetLayout();
   bool restoreLayout();
   void saveLayout();

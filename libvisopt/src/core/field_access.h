@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "core/field_view.h"
 #include "core/half.h"
@@ -89,5 +90,17 @@ struct AnyAccess {
     return f.half ? halfToFloat(floatToHalf(minOf(maxOf(v, -65504.f), 65504.f))) : v;
   }
 };
+
+// The storage of `f` through accessor A (Fp32Access, Fp16Access or AnyAccess); for the first
+// two the caller has checked that the view's precision is A's.
+template <class A>
+VISOPT_HD VISOPT_INLINE A accessTo(const FieldView& f) {
+  if constexpr (std::is_same_v<A, Fp16Access>)
+    return {static_cast<Half*>(f.data)};
+  else if constexpr (std::is_same_v<A, Fp32Access>)
+    return {static_cast<float*>(f.data)};
+  else
+    return {f};
+}
 
 }  // namespace visopt

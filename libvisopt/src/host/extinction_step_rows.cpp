@@ -65,12 +65,10 @@ struct RowStep {
     for (int l = 0; l < n; ++l) {
       const size_t v = v0 + size_t(l);
       const float m = mu.load(v);
-      float g = grad.rho * (m - mbar[l]);
-      g -= grad.q * dv[l];
-      g -= grad.r * dl[l];
-      g = step.gradientScale * g;
+      const float g = step.gradientScale *
+                      extinctionGradient(grad.rho, m, mbar[l], grad.q, dv[l], grad.r, dl[l]);
       const float delta = optimizerStep<kAdemamix>(m1, m2, rms, v, g, c);
-      const float next = minOf(maxOf(m + delta, 0.f), step.muMax);
+      const float next = projectExtinction(m + delta, step.muMax);
       mu.store(v, next);
       const float stored = mu.kept(next);
       const double dm = double(m - mbar[l]);
@@ -101,19 +99,11 @@ struct RowStep {
   }
 };
 
-template <class A>
-A accessOf(const FieldView& f) {
-  if constexpr (std::is_same_v<A, Fp16Access>)
-    return {static_cast<Half*>(f.data)};
-  else
-    return {static_cast<float*>(f.data)};
-}
-
 template <class A, bool kAdemamix>
 StepSums runRows(const ExtinctionStep& step) {
   const OptimizerState& s = step.state;
-  const RowStep<A, kAdemamix> k{step, accessOf<A>(step.gradient.mu), accessOf<A>(s.m1),
-                                kAdemamix ? accessOf<A>(s.m2) : A{}, accessOf<A>(s.rms)};
+  const RowStep<A, kAdemamix> k{step, accessTo<A>(step.gradient.mu), accessTo<A>(s.m1),
+                                kAdemamix ? accessTo<A>(s.m2) : A{}, accessTo<A>(s.rms)};
   const glm::ivec3 dims = step.gradient.volume.dims;
   const int64_t rows = int64_t(dims.y) * dims.z;
   return tbb::parallel_reduce(

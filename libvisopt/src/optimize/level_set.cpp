@@ -115,16 +115,6 @@ struct Tag {
   using type = A;
 };
 
-Fp32Access accessOf(const Field3D& f, Tag<Fp32Access>) {
-  return {static_cast<float*>(const_cast<void*>(f.raw()))};
-}
-Fp16Access accessOf(const Field3D& f, Tag<Fp16Access>) {
-  return {static_cast<Half*>(const_cast<void*>(f.raw()))};
-}
-AnyAccess accessOf(const Field3D& f, Tag<AnyAccess>) {
-  return {FieldView(f)};
-}
-
 // The fast path when every field shares one precision, any mix otherwise.
 template <class Fn>
 auto dispatch(std::initializer_list<const Field3D*> fields, Fn&& fn) {
@@ -202,10 +192,10 @@ ChangeSums substepWith(const Field3D& phi, const Field3D& phi0, const Field3D& g
                        const Band* band) {
   const GridSpec& g = phi.grid();
   LevelSetStepKernel<A, Order> k;
-  k.phi = accessOf(phi, Tag<A>{});
-  k.out = accessOf(out, Tag<A>{});
-  k.phi0 = accessOf(phi0, Tag<A>{});
-  k.ghat = accessOf(ghat, Tag<A>{});
+  k.phi = accessTo<A>(FieldView(phi));
+  k.out = accessTo<A>(FieldView(out));
+  k.phi0 = accessTo<A>(FieldView(phi0));
+  k.ghat = accessTo<A>(FieldView(ghat));
   if (mask) k.mask = mask->view();
   k.dims = g.dims;
   k.spacing = g.spacing;
@@ -240,10 +230,10 @@ double redistancePassWith(const Field3D& in, Field3D& out, bool initialise, cons
                           float stopBand, const Band* band, const BandMean& mean) {
   const GridSpec& g = in.grid();
   RedistanceKernel<A, Order> k;
-  k.in = accessOf(in, Tag<A>{});
-  k.out = accessOf(out, Tag<A>{});
+  k.in = accessTo<A>(FieldView(in));
+  k.out = accessTo<A>(FieldView(out));
   if (base) {
-    k.base = accessOf(*base, Tag<A>{});
+    k.base = accessTo<A>(FieldView(*base));
     k.keepWithin = kRedistanceKeepsBaseWithin * g.minSpacing();
   } else {
     k.withoutBase();

@@ -295,6 +295,8 @@ StepBounds NarrowBand::workBounds(const Field3D& ghat) {
   });
   for (const int32_t b : missing) boundsKnown_[size_t(b)] = 1;
   for (const int32_t b : bricks) total = total + brickBounds_[size_t(b)];
+  // The idle (fixed) bricks are not stepped but hold ghat = 0, which sets the smallest ghat and
+  // so the relaxation's bound lambda - min ghat, as it would over the whole band.
   if (fixedBricks_ > 0 && !idle_.empty()) total = total + StepBounds{0.f, 0.f, 0.f};
   return total;
 }

@@ -128,6 +128,7 @@ void BM_BandStepRedist(benchmark::State& state) {
   visopt::LevelSetSettings s;
   s.band = float(state.range(2));
   s.substeps = 1;
+  s.semiImplicit = false;  // one explicit substep: OpenVDB's counterpart below is one too
   s.redistanceIterations = 1;
   const bool kept = state.range(3) != 0;
   visopt::Field3D scratch;
@@ -142,6 +143,28 @@ void BM_BandStepRedist(benchmark::State& state) {
     benchmark::DoNotOptimize(rs.meanSquaredChange);
   }
   setCounters(state, double(bandVoxels > 0 ? bandVoxels : int64_t(d.phi.size())));
+}
+
+// The optimiser's level-set step per unit of flow time: one chunk of range(3) explicit
+// substeps' time on the kept band (half-width 8), as range(2) = 0: that many explicit substeps of
+// Eq. 23, 1: one semi-implicit step over the same time (kernels/implicit_diffusion.h). No
+// redistancing. ns_per_voxel divides the chunk's time by the band's voxels.
+void BM_BandChunk(benchmark::State& state) {
+  const int n = int(state.range(0));
+  DenseSetup d(n, precisionOf(state.range(1)));
+  visopt::LevelSetSettings s;
+  s.semiImplicit = state.range(2) != 0;
+  s.substeps = int(state.range(3));
+  visopt::Field3D scratch;
+  visopt::NarrowBand band;
+  int64_t bandVoxels = 0;
+  for (auto _ : state) {
+    const visopt::LevelSetStepStats st =
+        visopt::levelSetStep(d.phi, d.phi0, d.ghat, nullptr, s, scratch, &band);
+    bandVoxels = st.bandVoxels;
+    benchmark::DoNotOptimize(st.maxChange);
+  }
+  setCounters(state, double(bandVoxels));
 }
 
 // OpenVDB's counterpart of BM_BandStepRedist: LevelSetFilter::meanCurvature(), one explicit
@@ -194,6 +217,17 @@ void bandArgs(benchmark::internal::Benchmark* b) {
 BENCHMARK(BM_BandStepRedist)
     ->Apply(bandArgs)
     ->ArgNames({"n", "fp", "band", "kept"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+void chunkArgs(benchmark::internal::Benchmark* b) {
+  for (int n : {128, 256})
+    for (int p : {32, 16})
+      for (int semi : {0, 1})
+        for (int substeps : {16, 64}) b->Args({n, p, semi, substeps});
+}
+BENCHMARK(BM_BandChunk)
+    ->Apply(chunkArgs)
+    ->ArgNames({"n", "fp", "semi", "substeps"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_OpenVdbCurvatureStep)

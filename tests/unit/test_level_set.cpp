@@ -99,6 +99,7 @@ TEST(LevelSetFlow, SphereFollowsMeanCurvatureFlow) {
   Field3D scratch;
   LevelSetSettings s;
   s.lambda = 0.f;
+  s.semiImplicit = false;  // the explicit reference (test_level_set_semi_implicit: the other)
 
   const double r0 = equivalentRadius(phi);
   EXPECT_NEAR(r0, radius, 0.05);
@@ -491,6 +492,7 @@ TEST_P(LevelSet, HugeLambdaDoesNotOvershoot) {
   Field3D scratch;
   LevelSetSettings s;
   s.lambda = 1e6f;
+  s.semiImplicit = false;  // explicit Euler's return term (the semi-implicit one: exact decay)
   const LevelSetStepStats st = levelSetStep(phi, phi0, ghat, nullptr, s, scratch);
   EXPECT_NEAR(st.timeStep, s.cfl / 1e6, 1e-9);
   // Each substep moves phi a fraction cfl of the way to phi0: never past it.

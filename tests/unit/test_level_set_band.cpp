@@ -10,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <numbers>
+#include <tuple>
 #include <vector>
 
 #include "core/field_view.h"
@@ -101,9 +102,17 @@ struct SurfaceRun {
   int64_t bandVoxels = 0;
 };
 
-class LevelSetBand : public ::testing::TestWithParam<Precision> {
+// Each test runs for both precisions and both integrators of Eq. 23 (explicit Euler, the
+// reference, and the semi-implicit step): the band must not change what either computes.
+class LevelSetBand : public ::testing::TestWithParam<std::tuple<Precision, bool>> {
  protected:
-  float tolerance() const { return GetParam() == Precision::FP16 ? 0.06f : 0.05f; }
+  Precision precision() const { return std::get<0>(GetParam()); }
+  LevelSetSettings settings() const {
+    LevelSetSettings s;
+    s.semiImplicit = std::get<1>(GetParam());
+    return s;
+  }
+  float tolerance() const { return precision() == Precision::FP16 ? 0.06f : 0.05f; }
 };
 
 // Constant ghat: mean-curvature flow, with redistancing after every step as the optimiser does.
@@ -111,13 +120,13 @@ TEST_P(LevelSetBand, MeanCurvatureFlowMatchesTheDensePath) {
   const GridSpec g = box(glm::ivec3(96, 96, 96));
   const glm::vec3 centre(47.3f, 47.6f, 47.9f);
   const float radius = 20.f, c = 1.f;
-  const Field3D phi0 = makeField("phi0", g, GetParam(), sphere(centre, radius));
-  const Field3D ghat = makeField("ghat", g, GetParam(), [=](glm::vec3) { return c; });
-  LevelSetSettings banded;
+  const Field3D phi0 = makeField("phi0", g, precision(), sphere(centre, radius));
+  const Field3D ghat = makeField("ghat", g, precision(), [=](glm::vec3) { return c; });
+  LevelSetSettings banded = settings();
   banded.lambda = 0.f;
   LevelSetSettings dense = banded;
   dense.band = 0.f;
-  SurfaceRun b{makeField("phi", g, GetParam(), sphere(centre, radius)), {}};
+  SurfaceRun b{makeField("phi", g, precision(), sphere(centre, radius)), {}};
   SurfaceRun d{clone(b.phi), {}};
   double t = 0.0;
   int64_t most = 0;
@@ -161,9 +170,9 @@ TEST_P(LevelSetBand, TheBandFollowsASurfaceThirtyVoxels) {
   const GridSpec g = box(glm::ivec3(80, 80, 80));
   const glm::vec3 centre(39.4f, 39.7f, 39.6f);
   const float startRadius = 36.f, endRadius = 6.f, c = 1.f;
-  const Field3D phi0 = makeField("phi0", g, GetParam(), sphere(centre, startRadius));
-  const Field3D ghat = makeField("ghat", g, GetParam(), [=](glm::vec3) { return c; });
-  LevelSetSettings s;
+  const Field3D phi0 = makeField("phi0", g, precision(), sphere(centre, startRadius));
+  const Field3D ghat = makeField("ghat", g, precision(), [=](glm::vec3) { return c; });
+  LevelSetSettings s = settings();
   s.lambda = 0.f;
   s.substeps = 8;
   Field3D phi = clone(phi0), scratch;
@@ -213,7 +222,13 @@ TEST_P(LevelSetBand, TheBandFollowsASurfaceThirtyVoxels) {
       radius, expected, worstRadius, static_cast<long long>(firstBricks),
       static_cast<long long>(band.activeBricks()), static_cast<long long>(activated),
       static_cast<long long>(released), holes, covered, farthest);
-  EXPECT_NEAR(radius, expected, 0.3);
+  // The semi-implicit step is first order in time with an error that grows with the curvature:
+  // at the end (r ~ 6, steps of 8 substeps) it has shrunk the sphere too far, by 0.37 voxel in
+  // fp32 and 0.51 in fp16 (the explicit path: 0.1; the cause of fp16's extra 0.14 is not pinned
+  // down: the solves carry increments, whose fp16 rounding is fine near the surface).
+  // test_level_set_semi_implicit checks the scheme's accuracy on its own.
+  const bool semi = std::get<1>(GetParam());
+  EXPECT_NEAR(radius, expected, !semi ? 0.3 : precision() == Precision::FP16 ? 0.55 : 0.45);
   EXPECT_LT(worstRadius, 0.3);
   EXPECT_GT(covered, 1000);
   EXPECT_EQ(holes, 0);
@@ -231,13 +246,13 @@ TEST_P(LevelSetBand, TheBandFollowsASurfaceThirtyVoxels) {
 TEST_P(LevelSetBand, RelaxationFromFarAwayMatchesTheDensePath) {
   const GridSpec g = box(glm::ivec3(80, 80, 80));
   const glm::vec3 centre(39.5f, 40.2f, 39.8f);
-  const Field3D phi0 = makeField("phi0", g, GetParam(), sphere(centre, 12.f));
-  const Field3D ghat = makeField("ghat", g, GetParam(), [](glm::vec3) { return 0.f; });
-  LevelSetSettings banded;
+  const Field3D phi0 = makeField("phi0", g, precision(), sphere(centre, 12.f));
+  const Field3D ghat = makeField("ghat", g, precision(), [](glm::vec3) { return 0.f; });
+  LevelSetSettings banded = settings();
   banded.lambda = 0.5f;
   LevelSetSettings dense = banded;
   dense.band = 0.f;
-  SurfaceRun b{makeField("phi", g, GetParam(), sphere(centre, 30.f)), {}};
+  SurfaceRun b{makeField("phi", g, precision(), sphere(centre, 30.f)), {}};
   SurfaceRun d{clone(b.phi), {}};
   for (int n = 0; n < 10; ++n) {
     levelSetStep(b.phi, phi0, ghat, nullptr, banded, b.scratch);
@@ -261,12 +276,12 @@ TEST_P(LevelSetBand, RedistancingLeavesNoSeamsAtBrickFaces) {
   const glm::vec3 centre(31.3f, 32.1f, 31.7f);
   const float radius = 17.f;
   const Fn exact = sphere(centre, radius);
-  Field3D phi = makeField("phi", g, GetParam(), [&](glm::vec3 x) {
+  Field3D phi = makeField("phi", g, precision(), [&](glm::vec3 x) {
     const float distortion = 1.f + 0.5f * std::sin(0.3f * x.x + 0.2f * x.y) * std::cos(0.25f * x.z);
     return exact(x) * distortion;
   });
   Field3D scratch;
-  LevelSetSettings s;
+  LevelSetSettings s = settings();
   s.redistanceIterations = 200;
   const RedistanceStats st = redistance(phi, s, scratch);
   EXPECT_GT(st.bandVoxels, 0);
@@ -326,9 +341,9 @@ TEST_P(LevelSetBand, ExtremesMatchTheDensePath) {
   for (const Case& cs : cases) {
     SCOPED_TRACE(cs.name);
     const GridSpec g = box(cs.dims);
-    const Field3D phi0 = makeField("phi0", g, GetParam(), cs.phi);
-    const Field3D ghat = makeField("ghat", g, GetParam(), [&](glm::vec3) { return cs.ghat; });
-    LevelSetSettings banded;
+    const Field3D phi0 = makeField("phi0", g, precision(), cs.phi);
+    const Field3D ghat = makeField("ghat", g, precision(), [&](glm::vec3) { return cs.ghat; });
+    LevelSetSettings banded = settings();
     banded.lambda = 0.f;
     LevelSetSettings dense = banded;
     dense.band = 0.f;
@@ -364,10 +379,10 @@ TEST_P(LevelSetBand, ExtremesMatchTheDensePath) {
 TEST_P(LevelSetBand, FixedBricksAreSkippedWithoutChangingAnything) {
   const GridSpec g = box(glm::ivec3(64, 64, 64));
   const glm::vec3 centre(31.6f, 32.2f, 31.9f);
-  const Field3D phi0 = makeField("phi0", g, GetParam(), sphere(centre, 18.f));
+  const Field3D phi0 = makeField("phi0", g, precision(), sphere(centre, 18.f));
   const Field3D ghat =
-      makeField("ghat", g, GetParam(), [](glm::vec3 x) { return x.x < 24.f ? 0.6f : 0.f; });
-  LevelSetSettings s;
+      makeField("ghat", g, precision(), [](glm::vec3 x) { return x.x < 24.f ? 0.6f : 0.f; });
+  LevelSetSettings s = settings();
   s.lambda = 0.3f;
   s.substeps = 6;
   SurfaceRun marked{clone(phi0), {}}, plain{clone(phi0), {}};
@@ -403,10 +418,14 @@ TEST_P(LevelSetBand, FixedBricksAreSkippedWithoutChangingAnything) {
   EXPECT_GT(work, 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(Precisions, LevelSetBand,
-                         ::testing::Values(Precision::FP32, Precision::FP16),
+INSTANTIATE_TEST_SUITE_P(PrecisionsAndIntegrators, LevelSetBand,
+                         ::testing::Combine(::testing::Values(Precision::FP32, Precision::FP16),
+                                            ::testing::Values(false, true)),
                          [](const auto& param) {
-                           return std::string(param.param == Precision::FP16 ? "fp16" : "fp32");
+                           return std::string(std::get<0>(param.param) == Precision::FP16
+                                                  ? "fp16"
+                                                  : "fp32") +
+                                  (std::get<1>(param.param) ? "_semi_implicit" : "_explicit");
                          });
 
 }  // namespace

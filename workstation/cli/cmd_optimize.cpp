@@ -75,6 +75,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     int redistIterations = kLevelSet.redistanceIterations;
     float reach = kLevelSet.reach;
     float band = kLevelSet.band;
+    std::string integrator = kLevelSet.semiImplicit ? "semi-implicit" : "explicit";
     bool filled = false, deviationView = false;
     int resolution = 128, levels = kExtinction.levels,
         iterations = kExtinction.maxIterationsPerLevel;
@@ -130,6 +131,10 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--level-set-band", o->band,
                  "Half-width in voxels of the narrow band the level-set step and redistancing run "
                  "in (0: the whole grid, the dense reference path)");
+  app.add_option("--level-set-integrator", o->integrator,
+                 "How each iteration integrates Eq. 23: semi-implicit (one stable step per half "
+                 "voxel of motion) or explicit (Euler substeps, the paper's Eq. 25)")
+      ->check(CLI::IsMember({"semi-implicit", "explicit"}));
   app.add_option("--redist-iterations", o->redistIterations,
                  "Redistancing iterations at most (Eq. 18)");
   app.add_option("--world-mask", o->worldMask,
@@ -205,6 +210,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     if (given("--redist-iterations")) ls.redistanceIterations = o->redistIterations;
     if (given("--level-set-reach")) ls.reach = o->reach;
     if (given("--level-set-band")) ls.band = o->band;
+    if (given("--level-set-integrator")) ls.semiImplicit = o->integrator == "semi-implicit";
     engine.setLevelSetSettings(ls);
     if ((given("--shell") || o->filled) && !engine.contextSurfaces().empty()) {
       // --shell and --filled apply to a scene's own context surfaces too.

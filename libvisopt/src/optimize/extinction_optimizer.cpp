@@ -167,6 +167,10 @@ struct ExtinctionOptimizer::Level {
   double lastMotion = 0.0;  // bound on how far the surfaces moved in the last iteration, world
                             // units
   double lastEnergy = 0.0;
+  // The semi-implicit integrator's last chunk (substeps' time per step), where the next
+  // iteration starts: a chunk costs the same whatever its length, so restarting each iteration
+  // from `substeps` would double the steps of a level whose surfaces move slowly.
+  int semiImplicitChunk = 0;
   // Set by runMultigrid after the level's first iteration: ghat (Eq. 19) depends on the
   // importance, the view and light frusta and the screen weights only, none of which changes
   // within a run, so the frustum maxima of g and the importance-behind gather are not redone.
@@ -674,9 +678,10 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   const double h = double(L.grid.minSpacing());
   LevelSetSettings chunkSettings = in.levelSet;
   // A chunk is as many substeps as keep the surface's motion under half a voxel at the rate of
-  // the last chunk (at least `substeps`, at most 64), so redistancing runs about once per half
-  // voxel moved rather than after every few substeps of a slow surface.
+  // the last chunk (at least `substeps`, at most 64 explicit ones), so redistancing runs about once
+  // per half voxel moved rather than after every few substeps of a slow surface.
   int chunk = std::max(in.levelSet.substeps, 1);
+  if (in.levelSet.semiImplicit && L.semiImplicitChunk > 0) chunk = L.semiImplicitChunk;
   LevelSetStepStats ls;
   L.lastMotion = 0.0;
   int substepsDone = 0;
@@ -733,8 +738,13 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
     // (there is no interface to measure distance from). The next iteration tries again, so a
     // surface that the return term brings back carries on.
     if (!anySurface) break;
-    const double fits = rate > 0.0 ? 0.5 * h / rate : 64.0;
-    chunk = int(std::clamp(std::floor(fits), double(std::max(in.levelSet.substeps, 1)), 64.0));
+    // Explicit substeps are stable only one by one, so a chunk is bounded by how often the
+    // motion is checked; a semi-implicit chunk is one step of any length, bounded by accuracy
+    // alone (the half voxel).
+    const double most = in.levelSet.semiImplicit ? 4096.0 : 64.0;
+    const double fits = rate > 0.0 ? 0.5 * h / rate : most;
+    chunk = int(std::clamp(std::floor(fits), double(std::max(in.levelSet.substeps, 1)), most));
+    if (in.levelSet.semiImplicit) L.semiImplicitChunk = chunk;
   }
   for (const NarrowBand& b : L.bands) {
     st.bandVoxels += b.band().voxels;

@@ -13,9 +13,11 @@
 #include <tbb/parallel_reduce.h>
 
 #include "core/device_bit_mask.h"
+#include "core/device_buffer.h"
 #include "core/field_view.h"
 #include "core/voxel_ijk.h"
 #include "exec/parallel.h"
+#include "kernels/implicit_diffusion.h"
 #include "kernels/level_set_step.h"
 #include "kernels/redistance.h"
 #include "optimize/narrow_band.h"
@@ -301,6 +303,157 @@ StepBounds stepBoundsWithin(const Field3D& ghat, const Band& band) {
       [](const StepBounds& a, const StepBounds& b) { return a + b; });
 }
 
+// ---- the semi-implicit step (kernels/implicit_diffusion.h) -----------------------------------
+
+static_assert(kImplicitLanes == kBrick, "a group of lines is one brick wide");
+
+// The groups of lines along `axis` (0 x, 1 y, 2 z) through the bricks flagged in `work` (per
+// brick, x fastest; empty: every brick, the dense path), each run of consecutive flagged bricks
+// along the axis one segment. Lanes run along x for y and z lines, along y for x lines.
+// `floats` is set to the coefficient floats all groups need together (2 n lanes each).
+std::vector<ImplicitLines> implicitLinesAlong(const glm::ivec3& dims, int axis,
+                                              const std::vector<uint8_t>& work, int64_t& floats) {
+  const glm::ivec3 nb = (dims + (kBrick - 1)) / kBrick;
+  const int64_t stride[3] = {1, int64_t(dims.x), int64_t(dims.x) * dims.y};
+  const int laneAxis = axis == 0 ? 1 : 0;
+  const int groupAxis = 3 - axis - laneAxis;
+  auto flagged = [&](const glm::ivec3& b) {
+    return work.empty() ||
+           work[(size_t(b.z) * size_t(nb.y) + size_t(b.y)) * size_t(nb.x) + size_t(b.x)] != 0;
+  };
+  std::vector<ImplicitLines> lines;
+  floats = 0;
+  glm::ivec3 b(0);
+  for (int q = 0; q < nb[groupAxis]; ++q)
+    for (int p = 0; p < nb[laneAxis]; ++p) {
+      b[groupAxis] = q;
+      b[laneAxis] = p;
+      for (int start = 0; start < nb[axis];) {
+        b[axis] = start;
+        if (!flagged(b)) {
+          ++start;
+          continue;
+        }
+        int end = start + 1;
+        for (; end < nb[axis]; ++end) {
+          b[axis] = end;
+          if (!flagged(b)) break;
+        }
+        const int v0 = start * kBrick, v1 = std::min(end * kBrick, dims[axis]);
+        const int lane0 = p * kBrick, g0 = q * kBrick;
+        const int g1 = std::min(g0 + kBrick, dims[groupAxis]);
+        for (int g = g0; g < g1; ++g) {
+          ImplicitLines L;
+          L.first = v0 * stride[axis] + lane0 * stride[laneAxis] + g * stride[groupAxis];
+          L.step = stride[axis];
+          L.laneStep = stride[laneAxis];
+          L.n = v1 - v0;
+          L.lanes = std::min(kBrick, dims[laneAxis] - lane0);
+          L.lowFace = v0 == 0;
+          L.highFace = v1 == dims[axis];
+          L.coefficients = floats;
+          floats += 2 * int64_t(L.n) * kImplicitLanes;
+          lines.push_back(L);
+        }
+        start = end;
+      }
+    }
+  return lines;
+}
+
+// One LOD solve along one axis over the groups of lines: on the CPU each task keeps its
+// coefficients in a buffer of its own (one line's worth, cache-resident), on CUDA each group
+// has its slice of one buffer.
+template <class A>
+void solveImplicitAxis(const Field3D& delta, const Field3D& ghat, const Field3D& before, int axis,
+                       bool firstAxis, const std::vector<ImplicitLines>& lines, int64_t floats,
+                       float r) {
+  if (lines.empty()) return;
+  const A d = accessTo<A>(FieldView(delta));
+  const A g = accessTo<A>(FieldView(ghat));
+  const A b = accessTo<A>(FieldView(before));
+  const bool unitLanes = axis != 0;
+  const int64_t n = int64_t(lines.size());
+  if (activeBackend() == Backend::CUDA) {
+    DeviceBuffer<ImplicitLines> list(lines.size());
+    std::copy(lines.begin(), lines.end(), list.data());
+    DeviceBuffer<float> coefficients{size_t(floats)};
+    const ImplicitLines* l = list.data();
+    float* w = coefficients.data();
+    exec::parallelFor("level set: semi-implicit solve", n, [=] VISOPT_HD(int64_t i) {
+      if (unitLanes)
+        solveImplicitLines<A, true>(d, g, b, l[i], r, w, firstAxis);
+      else
+        solveImplicitLines<A, false>(d, g, b, l[i], r, w, firstAxis);
+    });
+    return;
+  }
+  int32_t longest = 0;
+  for (const ImplicitLines& L : lines) longest = std::max(longest, L.n);
+  exec::LaunchTimer timer("level set: semi-implicit solve", double(n));
+  tbb::parallel_for(tbb::blocked_range<int64_t>(0, n, 8),
+                    [&](const tbb::blocked_range<int64_t>& range) {
+                      std::vector<float> w(size_t(2) * size_t(longest) * kImplicitLanes);
+                      for (int64_t i = range.begin(); i != range.end(); ++i) {
+                        ImplicitLines L = lines[size_t(i)];
+                        L.coefficients = 0;
+                        if (unitLanes)
+                          solveImplicitLines<A, true>(d, g, b, L, r, w.data(), firstAxis);
+                        else
+                          solveImplicitLines<A, false>(d, g, b, L, r, w.data(), firstAxis);
+                      }
+                    });
+}
+
+// Eq. 23 over time `dt` in one semi-implicit step: phi^n must be in `before` over the voxels
+// updated (the work spans on the band path, every voxel otherwise); returns the change sums
+// against it.
+template <class A>
+ChangeSums semiImplicitWith(Field3D& phi, const Field3D& before, const Field3D& phi0,
+                            const Field3D& ghat, const DeviceBitMask* mask,
+                            const LevelSetSettings& s, double dt, const Band* band,
+                            const std::vector<uint8_t>& workBricks) {
+  const GridSpec& g = phi.grid();
+  // phi holds the increment phi_D - phi^n from the first solve on (over the work bricks).
+  bool solved = false;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (g.dims[axis] < 2) continue;
+    int64_t floats = 0;
+    const std::vector<ImplicitLines> lines = implicitLinesAlong(g.dims, axis, workBricks, floats);
+    const double h = double(g.spacing[axis]);
+    solveImplicitAxis<A>(phi, ghat, before, axis, !solved, lines, floats, float(dt / (h * h)));
+    solved = true;
+  }
+  SemiImplicitFinish<A> k;
+  k.phi = accessTo<A>(FieldView(phi));
+  k.before = accessTo<A>(FieldView(before));
+  k.phi0 = accessTo<A>(FieldView(phi0));
+  k.ghat = accessTo<A>(FieldView(ghat));
+  if (mask) k.mask = mask->view();
+  k.dt = float(dt);
+  k.lambda = s.lambda;
+  k.nearBand = kNearSurfaceBand * g.minSpacing();
+  k.nx = g.dims.x;
+  k.solved = solved;
+  // Over the solved bricks only: the work spans may also cross a fixed brick (narrow_band.h),
+  // where phi holds values, not increments.
+  if (band) {
+    const SpanList solvedSpans = spansOfBricks(workBricks, g.dims);
+    return launchBand<ChangeSums>("level set: semi-implicit finish (band)", k, solvedSpans);
+  }
+  return launchStencil<ChangeSums>("level set: semi-implicit finish", k, g.dims);
+}
+
+ChangeSums semiImplicitStep(Field3D& phi, const Field3D& before, const Field3D& phi0,
+                            const Field3D& ghat, const DeviceBitMask* mask,
+                            const LevelSetSettings& s, double dt, const Band* band,
+                            const std::vector<uint8_t>& workBricks) {
+  return dispatch({&phi, &before, &phi0, &ghat}, [&](auto tag) {
+    using A = typename decltype(tag)::type;
+    return semiImplicitWith<A>(phi, before, phi0, ghat, mask, s, dt, band, workBricks);
+  });
+}
+
 }  // namespace
 
 double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s) {
@@ -357,14 +510,29 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
   } else {
     stats.timeStep = levelSetTimeStep(ghat, s);
   }
-  pingPong(phi, scratch, s.substeps, work, [&](const Field3D& from, Field3D& to, int) {
-    const ChangeSums c = substep(from, phi0, ghat, mask, s, float(stats.timeStep), to, work);
-    stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
-    stats.insideRise = std::max(stats.insideRise, double(c.insideRiseMax));
-    stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
-    stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
-    return false;
-  });
+  if (s.semiImplicit && s.substeps > 0) {
+    // One step over the substeps' time; the statistics per substep's worth of it, as below.
+    // scratch holds phi^n: over the band's halo from above, everywhere on the dense path.
+    if (!banded) copyField(phi, scratch);
+    std::vector<uint8_t> workBricks;
+    if (banded) workBricks = narrow.workBrickFlags(work != &narrow.band());
+    const double n = double(s.substeps);
+    const ChangeSums c =
+        semiImplicitStep(phi, scratch, phi0, ghat, mask, s, stats.timeStep * n, work, workBricks);
+    stats.maxChange = double(c.maxAbs) / n;
+    stats.insideRise = double(c.insideRiseMax) / n;
+    stats.nearMaxChange = double(c.nearMaxAbs) / n;
+    stats.meanChange = c.sumAbs / double(phi.size()) / n;
+  } else {
+    pingPong(phi, scratch, s.substeps, work, [&](const Field3D& from, Field3D& to, int) {
+      const ChangeSums c = substep(from, phi0, ghat, mask, s, float(stats.timeStep), to, work);
+      stats.maxChange = std::max(stats.maxChange, double(c.maxAbs));
+      stats.insideRise = std::max(stats.insideRise, double(c.insideRiseMax));
+      stats.nearMaxChange = std::max(stats.nearMaxChange, double(c.nearMaxAbs));
+      stats.meanChange += c.sumAbs / double(phi.size()) / double(s.substeps);
+      return false;
+    });
+  }
   if (!banded) {
     stats.hasInterface = hasInterface(phi);
     return stats;

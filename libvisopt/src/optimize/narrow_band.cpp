@@ -124,6 +124,12 @@ void appendSpans(const std::vector<uint8_t>& flags, glm::ivec3 nb, glm::ivec3 d,
 
 }  // namespace
 
+SpanList spansOfBricks(const std::vector<uint8_t>& flags, glm::ivec3 dims) {
+  SpanList out;
+  appendSpans(flags, (dims + (kBrick - 1)) / kBrick, dims, out);
+  return out;
+}
+
 void NarrowBand::build(const Field3D& phi, const Field3D* phi0, float halfWidthVoxels) {
   clear();
   dims_ = phi.grid().dims;
@@ -249,6 +255,13 @@ void NarrowBand::rebuildSpans() {
   for (const int32_t a : active_) (work[size_t(a)] ? workBricks_ : idle_).push_back(a);
   appendSpans(work, nb_, dims_, work_);
   appendSpans(dilated(work, nb_), nb_, dims_, workHalo_);
+}
+
+std::vector<uint8_t> NarrowBand::workBrickFlags(bool skipFixed) const {
+  std::vector<uint8_t> work(flags_.size(), 0);
+  for (const int32_t a : active_)
+    work[size_t(a)] = !skipFixed || flags_[size_t(a)] == kActiveBrick ? 1 : 0;
+  return work;
 }
 
 void NarrowBand::markFixed(const Field3D& phi, const Field3D& ghat) {

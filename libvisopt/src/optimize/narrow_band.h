@@ -56,6 +56,10 @@ struct SpanList {
   int64_t voxels = 0;
 };
 
+// The x-spans (one per voxel row) of the bricks flagged in `flags` (per brick, x fastest) of a
+// grid of `dims` voxels.
+SpanList spansOfBricks(const std::vector<uint8_t>& flags, glm::ivec3 dims);
+
 class NarrowBand {
  public:
   static constexpr float kReleaseMarginVoxels = 2.f;
@@ -92,6 +96,11 @@ class NarrowBand {
   // Voxels of the band outside the work spans with |phi| <= nearBand (world units): what a
   // mean over the band counts there (their change is 0). Cached until the spans change.
   int64_t idleNearVoxels(const Field3D& phi, float nearBand);
+
+  // Per brick (x fastest, brickDims() of them): 1 where the kernels update it, i.e. active and,
+  // with skipFixed, not fixed (the semi-implicit step's lines run through these).
+  std::vector<uint8_t> workBrickFlags(bool skipFixed) const;
+  glm::ivec3 brickDims() const { return nb_; }
 
   bool empty() const { return active_.empty(); }
   const Field3D* base() const { return phi0_; }

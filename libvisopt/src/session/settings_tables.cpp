@@ -38,7 +38,8 @@ const FieldTable<LevelSetSettings>& levelSetFields() {
                                 .add("redistanceIterations", &S::redistanceIterations)
                                 .add("redistanceTolerance", &S::redistanceTolerance)
                                 .add("spatialOrder", &S::spatialOrder)
-                                .add("band", &S::band);
+                                .add("band", &S::band)
+                                .add("semiImplicit", &S::semiImplicit);
   return table;
 }
 

@@ -47,7 +47,8 @@ bool sameExtinction(const ExtinctionSettings& a, const ExtinctionSettings& b) {
 bool sameLevelSet(const LevelSetSettings& a, const LevelSetSettings& b) {
   return a.lambda == b.lambda && a.curvatureEpsilon == b.curvatureEpsilon && a.cfl == b.cfl &&
          a.substeps == b.substeps && a.redistanceIterations == b.redistanceIterations &&
-         a.redistanceTolerance == b.redistanceTolerance && a.spatialOrder == b.spatialOrder;
+         a.redistanceTolerance == b.redistanceTolerance && a.spatialOrder == b.spatialOrder &&
+         a.semiImplicit == b.semiImplicit;
 }
 
 std::vector<ContextSurfaceSpec> twoSurfaces() {
@@ -105,7 +106,12 @@ class TestPanels : public QObject {
     QCOMPARE(last().maxIterationsPerLevel, 120);
     child<QSpinBox>(panel, "redistanceIterations")->setValue(16);
     QCOMPARE(lastLs().redistanceIterations, 16);
-    QCOMPARE(spy.count(), 11);
+    auto* integrator = child<QComboBox>(panel, "levelSetIntegrator");
+    QVERIFY(integrator->currentText().contains(QStringLiteral("default")));
+    QCOMPARE(lastLs().semiImplicit, true);
+    integrator->setCurrentIndex(integrator->findData(0));
+    QCOMPARE(lastLs().semiImplicit, false);
+    QCOMPARE(spy.count(), 12);
 
     // Everything else stayed as it was; the getters agree with the signal.
     ExtinctionSettings expect = e;
@@ -120,12 +126,13 @@ class TestPanels : public QObject {
     LevelSetSettings expectLs = ls;
     expectLs.lambda = 0.45f;
     expectLs.redistanceIterations = 16;
+    expectLs.semiImplicit = false;
     QVERIFY(sameLevelSet(lastLs(), expectLs));
     QVERIFY(sameLevelSet(panel.levelSetSettings(), expectLs));
 
     // setSettings emits nothing.
     panel.setSettings(ExtinctionSettings{}, LevelSetSettings{}, Precision::FP32);
-    QCOMPARE(spy.count(), 11);
+    QCOMPARE(spy.count(), 12);
   }
 
   void optimizationResetRestoresDefaults() {
@@ -190,9 +197,10 @@ class TestPanels : public QObject {
     QCOMPARE(restart.count(), 1);
 
     // Every field has a tooltip.
-    for (const char* name : {"rho", "rhoAuto", "q", "r", "lambda", "learningRate", "optimizer",
-                             "levels", "iterationsPerLevel", "redistanceIterations", "precision",
-                             "reset", "run", "freeze", "restart"})
+    for (const char* name :
+         {"rho", "rhoAuto", "q", "r", "lambda", "learningRate", "optimizer", "levels",
+          "iterationsPerLevel", "redistanceIterations", "levelSetIntegrator", "precision", "reset",
+          "run", "freeze", "restart"})
       QVERIFY2(!child<QWidget>(panel, name)->toolTip().isEmpty(), name);
   }
 

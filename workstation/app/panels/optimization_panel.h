@@ -70,6 +70,7 @@ class OptimizationPanel : public QWidget {
   QDoubleSpinBox* lambda_ = nullptr;
   QDoubleSpinBox* learningRate_ = nullptr;
   QComboBox* optimizer_ = nullptr;
+  QComboBox* integrator_ = nullptr;  // LevelSetSettings::semiImplicit
   QSpinBox* levels_ = nullptr;
   QSpinBox* iterations_ = nullptr;
   QSpinBox* redistance_ = nullptr;

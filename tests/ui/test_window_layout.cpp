@@ -173,6 +173,25 @@ void TestWindowLayout::commandLineFilesAreSorted() {
 
   f = sortCommandLineFiles({});
   QVERIFY(f.error.isEmpty() && f.volume.isEmpty() && f.session.isEmpty() && f.surfaces.isEmpty());
+
+  // The options add their scene, or refuse a second one (it used to open one silently).
+  f = sortCommandLineFiles({QStringLiteral("skin.ply")});
+  addSceneOptions(f, {QStringLiteral("a.nii"), {}, {}});
+  QVERIFY(f.error.isEmpty());
+  QCOMPARE(f.volume, QStringLiteral("a.nii"));
+  f = sortCommandLineFiles({});
+  addSceneOptions(f, {{}, {}, QStringLiteral("builtin:mixer")});
+  QCOMPARE(f.scene, QStringLiteral("builtin:mixer"));
+  f = sortCommandLineFiles({QStringLiteral("b.nii")});
+  addSceneOptions(f, {QStringLiteral("a.nii"), {}, {}});
+  QVERIFY(f.error.contains(QStringLiteral("--volume a.nii")) &&
+          f.error.contains(QStringLiteral("b.nii")));
+  f = sortCommandLineFiles({});
+  addSceneOptions(f, {QStringLiteral("a.nii"), {}, QStringLiteral("builtin:mixer")});
+  QVERIFY(f.error.contains(QStringLiteral("--scene builtin:mixer")));
+  f = sortCommandLineFiles({QStringLiteral("w.visopt-session")});
+  addSceneOptions(f, {{}, QStringLiteral("v.visopt-session"), {}});
+  QVERIFY(!f.error.isEmpty());
 }
 
 void TestWindowLayout::meshOnTheCommandLineBecomesAContextSurface() {

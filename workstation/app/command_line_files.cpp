@@ -35,4 +35,24 @@ CommandLineFiles sortCommandLineFiles(const QStringList& paths) {
   return files;
 }
 
+void addSceneOptions(CommandLineFiles& files, const SceneOptions& options) {
+  if (!files.error.isEmpty()) return;
+  QString named = !files.volume.isEmpty() ? files.volume : files.session;
+  auto add = [&](const QString& value, const QString& option, QString& into) {
+    if (value.isEmpty() || !files.error.isEmpty()) return;
+    if (!named.isEmpty()) {
+      files.error = QStringLiteral(
+                        "%1 %2: only one volume, session or scene opens at a time (%3 "
+                        "is open)")
+                        .arg(option, value, named);
+      return;
+    }
+    named = value;
+    into = value;
+  };
+  add(options.volume, QStringLiteral("--volume"), files.volume);
+  add(options.session, QStringLiteral("--session"), files.session);
+  add(options.scene, QStringLiteral("--scene"), files.scene);
+}
+
 }  // namespace visopt::ws

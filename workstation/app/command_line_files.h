@@ -11,6 +11,7 @@ namespace visopt::ws {
 struct CommandLineFiles {
   QString volume;        // a volume file or a DICOM folder
   QString session;       // a .visopt-session (or .json) session
+  QString scene;         // a built-in scene, "builtin:NAME" (from --scene only)
   QStringList surfaces;  // context-surface sources: "mesh:FILE" or "vdb:FILE"
   QString error;         // non-empty: the files cannot be opened together (one line)
 };
@@ -19,5 +20,17 @@ struct CommandLineFiles {
 // .vdb level sets become context surfaces; anything else (a folder, .nii, .mhd, .vti, .raw, ...)
 // is a volume, which the readers identify. At most one volume or session.
 CommandLineFiles sortCommandLineFiles(const QStringList& paths);
+
+// The scene options given besides the files (empty: not given).
+struct SceneOptions {
+  QString volume;   // --volume
+  QString session;  // --session
+  QString scene;    // --scene
+};
+
+// Adds the options' scene to `files`: an error (one line naming both) when the files and the
+// options together name more than one volume, session or built-in scene, instead of opening
+// one of them silently.
+void addSceneOptions(CommandLineFiles& files, const SceneOptions& options);
 
 }  // namespace visopt::ws

@@ -148,13 +148,14 @@ int main(int argc, char** argv) {
       QStringLiteral("[FILE...]"));
   parser.process(app);
 
-  const CommandLineFiles files = sortCommandLineFiles(parser.positionalArguments());
+  CommandLineFiles files = sortCommandLineFiles(parser.positionalArguments());
+  addSceneOptions(files, {parser.value(volume), parser.value(session), parser.value(scene)});
   if (!files.error.isEmpty()) {
     std::fprintf(stderr, "visopt-workstation: %s\n", files.error.toUtf8().constData());
     return 2;
   }
-  const QString volumePath = files.volume.isEmpty() ? parser.value(volume) : files.volume;
-  const QString sessionPath = files.session.isEmpty() ? parser.value(session) : files.session;
+  const QString volumePath = files.volume;
+  const QString sessionPath = files.session;
 
   const bool scripted = parser.isSet(screenshot) || parser.isSet(windowShot) ||
                         parser.isSet(latency) || parser.isSet(saveTo);
@@ -180,7 +181,7 @@ int main(int argc, char** argv) {
   } else if (!volumePath.isEmpty()) {
     window.openVolume(volumePath);
   } else if (!recovered) {
-    QString name = parser.value(scene);
+    QString name = files.scene;
     if (name.startsWith(QStringLiteral("builtin:"))) name = name.mid(8);
     if (name.isEmpty()) name = QString::fromStdString(defaultSceneName());
     window.openBuiltinScene(name, parser.value(resolution).toInt());

@@ -2,6 +2,7 @@
 // gives a filled SDF whose zero set lies within a voxel of the mesh, an open one only a thin shell;
 // broken files are refused with one line naming the file; .vdb files round-trip; the CLI maps
 // errors to exit codes.
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <array>
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -254,6 +256,33 @@ TEST(MeshSdf, EveryFormatLoads) {
     EXPECT_TRUE(report.closed && report.manifold);
     EXPECT_NEAR(sampleAt(sdf, kCentre), -kRadius, 0.08f);
   }
+}
+
+// An OBJ whose `mtllib` names a FIFO (no writer: opening it blocks for good) or a device loads
+// without reading it: materials are never opened (issue 13). Without the guard this test hangs
+// until ctest's timeout.
+TEST(MeshSdf, ObjMaterialReferencesAreNeverOpened) {
+  const Mesh m = icosphere(2, kCentre, kRadius);
+  const std::string fifo = tmp("materials_fifo.mtl");
+  std::remove(fifo.c_str());
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  for (const std::string& library : {std::string("materials_fifo.mtl"), std::string("/dev/zero")}) {
+    SCOPED_TRACE(library);
+    const std::string path = tmp("with_materials.obj");
+    writeObj(m, path);
+    {
+      std::ifstream in(path);
+      std::stringstream body;
+      body << in.rdbuf();
+      writeText(path,
+                "# exported with materials\n  mtllib " + library + "\nusemtl skin\n" + body.str());
+    }
+    MeshReport report;
+    const Field3D sdf = sdfFromMesh(path, filledOptions(0.08f), Precision::FP32, nullptr, &report);
+    EXPECT_EQ(report.faces, m.f.size());
+    EXPECT_NEAR(sampleAt(sdf, kCentre), -kRadius, 0.08f);
+  }
+  std::remove(fifo.c_str());
 }
 
 TEST(MeshSdf, Fp16StorageKeepsTheSurface) {

@@ -14,6 +14,7 @@
 #include <iostream>
 #include <mutex>
 #include <sstream>
+#include <streambuf>
 #include <unordered_map>
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -437,6 +438,50 @@ TriangleMesh repairAndCheck(const std::string& path, const std::vector<glm::vec3
 
 }  // namespace
 
+namespace {
+
+// A seekable stream over a buffer the caller owns (OpenMesh's OBJ reader reads from an
+// std::istream, in two passes: it seeks back to the start).
+struct MemoryBuffer : std::streambuf {
+  MemoryBuffer(char* data, size_t size) { setg(data, data, data + size); }
+  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
+    char* base = dir == std::ios_base::beg ? eback() : dir == std::ios_base::cur ? gptr() : egptr();
+    char* target = base + off;
+    if (target < eback() || target > egptr()) return pos_type(off_type(-1));
+    setg(eback(), target, egptr());
+    return pos_type(off_type(target - eback()));
+  }
+  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
+    return seekoff(off_type(pos), std::ios_base::beg, which);
+  }
+};
+
+// OpenMesh's OBJ reader opens whatever file an `mtllib` line names, relative to the OBJ: a FIFO
+// blocks it for good, a device makes it read forever. A volume tool has no use for materials,
+// so an OBJ is read from memory with those lines turned into comments (line numbers stay).
+bool readObjWithoutMaterials(PolyMesh& mesh, const std::string& path, uint64_t size) {
+  std::string text(size_t(size), '\0');
+  {
+    std::ifstream in(path, std::ios::binary);
+    in.read(text.data(), std::streamsize(size));
+    if (!in) throwBadInput(path, "could not read the whole file");
+  }
+  for (size_t line = 0; line < text.size();) {
+    size_t word = line;
+    while (word < text.size() && (text[word] == ' ' || text[word] == '\t')) ++word;
+    if (text.compare(word, 6, "mtllib") == 0) text[word] = '#';
+    const size_t end = text.find('\n', line);
+    if (end == std::string::npos) break;
+    line = end + 1;
+  }
+  MemoryBuffer buffer(text.data(), text.size());
+  std::istream stream(&buffer);
+  OpenMesh::IO::Options options;
+  return OpenMesh::IO::read_mesh(mesh, stream, ".obj", options);
+}
+
+}  // namespace
+
 TriangleMesh loadMesh(const std::string& path, MeshReport& report, const ProgressCallback& progress,
                       float progressEnd) {
   report = MeshReport{};
@@ -461,7 +506,8 @@ TriangleMesh loadMesh(const std::string& path, MeshReport& report, const Progres
     std::lock_guard<std::mutex> lock(openMeshStreamMutex());
     OpenMeshErrorCapture capture;
     try {
-      ok = OpenMesh::IO::read_mesh(polyMesh, path);
+      ok = obj ? readObjWithoutMaterials(polyMesh, path, size)
+               : OpenMesh::IO::read_mesh(polyMesh, path);
     } catch (const std::exception& e) {
       ok = false;
       messages = e.what();

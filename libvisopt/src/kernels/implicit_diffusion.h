@@ -101,6 +101,21 @@ VISOPT_HD VISOPT_INLINE void forwardRow(const A& delta, const A& ghat, const A& 
   }
 }
 
+// The forward sweep's element i for every lane, its c' and d' kept in cw and dw.
+template <class A, bool Edge, bool FirstAxis, class Lane>
+VISOPT_HD VISOPT_INLINE void forwardElement(const A& delta, const A& ghat, const A& before,
+                                            const ImplicitLines& L, int32_t i, float r,
+                                            const Lane& lane, float* cPrev, float* dPrev, float* cw,
+                                            float* dw) {
+  const int64_t base = L.first + int64_t(i) * L.step;
+  for (int l = 0; l < kImplicitLanes; ++l) {
+    forwardRow<A, Edge, FirstAxis>(delta, ghat, before, L, base + lane(l), i, r, cPrev[l],
+                                   dPrev[l]);
+    cw[int64_t(i) * kImplicitLanes + l] = cPrev[l];
+    dw[int64_t(i) * kImplicitLanes + l] = dPrev[l];
+  }
+}
+
 // Full: all kImplicitLanes lanes are lines (else lanes past L.lanes repeat the last line and
 // are never stored).
 template <class A, bool UnitLanes, bool Full, bool FirstAxis>
@@ -114,26 +129,12 @@ VISOPT_HD void solveLines(const A& delta, const A& ghat, const A& before, const 
   auto lane = [&](int l) { return int64_t(Full ? l : (l < lanes ? l : lanes - 1)) * laneStep; };
   float cPrev[W], dPrev[W];
   for (int l = 0; l < W; ++l) cPrev[l] = dPrev[l] = 0.f;
-  auto edge = [&](int32_t i) {
-    const int64_t base = L.first + int64_t(i) * L.step;
-    for (int l = 0; l < W; ++l) {
-      forwardRow<A, true, FirstAxis>(delta, ghat, before, L, base + lane(l), i, r, cPrev[l],
-                                     dPrev[l]);
-      cw[int64_t(i) * W + l] = cPrev[l];
-      dw[int64_t(i) * W + l] = dPrev[l];
-    }
-  };
-  edge(0);
-  for (int32_t i = 1; i + 1 < L.n; ++i) {
-    const int64_t base = L.first + int64_t(i) * L.step;
-    for (int l = 0; l < W; ++l) {
-      forwardRow<A, false, FirstAxis>(delta, ghat, before, L, base + lane(l), i, r, cPrev[l],
-                                      dPrev[l]);
-      cw[int64_t(i) * W + l] = cPrev[l];
-      dw[int64_t(i) * W + l] = dPrev[l];
-    }
-  }
-  if (L.n > 1) edge(L.n - 1);
+  forwardElement<A, true, FirstAxis>(delta, ghat, before, L, 0, r, lane, cPrev, dPrev, cw, dw);
+  for (int32_t i = 1; i + 1 < L.n; ++i)
+    forwardElement<A, false, FirstAxis>(delta, ghat, before, L, i, r, lane, cPrev, dPrev, cw, dw);
+  if (L.n > 1)
+    forwardElement<A, true, FirstAxis>(delta, ghat, before, L, L.n - 1, r, lane, cPrev, dPrev, cw,
+                                       dw);
   float u[W];
   for (int l = 0; l < W; ++l) u[l] = 0.f;
   for (int32_t i = L.n - 1; i >= 0; --i) {

@@ -15,8 +15,10 @@ class MemoryLedger;
 class DeviceBitMask;
 class NarrowBand;
 
-// s.substeps explicit Euler substeps of Eq. 23 on phi (in place; `scratch` is the second
-// buffer, (re)allocated like phi when it does not match phi's grid and precision). Each
+// s.substeps explicit Euler substeps of Eq. 23 on phi, or with s.semiImplicit one
+// semi-implicit step over the same time (kernels/implicit_diffusion.h; the statistics then per
+// substep's worth of it), in place; `scratch` is the second buffer, (re)allocated like phi when
+// it does not match phi's grid and precision. Each
 // substep's dt = s.cfl x min(dx / max|grad ghat|, dx^2 / (6 max ghat), 1 / max lambda(x)),
 // dx the smallest spacing; terms whose maximum is 0 drop out, and dt is at most s.cfl x dx^2
 // (world units) when all of them do. s.cfl is clamped to (0, 1]. `mask` (nullable; a set bit =

@@ -2,8 +2,11 @@
 // kernel by kernel, on the same fields in the same run, against a STREAM-like probe run in the same
 // process: the reference per-ray scan (kernels/visibility_scan.h), the fast per-ray scan
 // (kernels/visibility_scan_fast.h, buffered: what a one-thread-per-ray backend runs) and the
-// tiled scan the CPU backend runs (host/visibility_scan_tiles.h). All three use the tiled layout
-// of the frustum fields (core/frustum_field.h).
+// tiled scan the CPU backend runs (host/visibility_scan_tiles.h), and the tiled scan with the
+// empty-space skip grid the optimiser builds every iteration (kernels/scan_skip.h; its build is
+// timed with it). All use the tiled layout of the frustum fields (core/frustum_field.h). mu is
+// nowhere zero in this scene, so the skip grid can only skip behind the surface: real scans with
+// air around them skip more (see docs/optimization-benchmarks.md for the Cranium CT).
 //
 // One benchmark per (kernel, volume N^3, view frustum F^2 or the light grid, precision, context
 // surface or not). The scene is synthetic and the same for every case: mu a smooth blob
@@ -42,6 +45,7 @@
 #include "host/visibility_scan_tiles.h"
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan_fast.h"
+#include "optimize/scan_skip_grid.h"
 #include "stream_probe.h"
 #include "visopt/camera.h"
 #include "visopt/exec.h"
@@ -52,7 +56,7 @@ namespace {
 
 using visopt::Precision;
 
-enum class Kernel { Reference, PerRay, Tiled };
+enum class Kernel { Reference, PerRay, Tiled, TiledSkip };
 
 struct Case {
   Kernel kernel;
@@ -63,9 +67,10 @@ struct Case {
 };
 
 std::string nameOf(const Case& c) {
-  const char* kernel = c.kernel == Kernel::Tiled    ? "tiled"
-                       : c.kernel == Kernel::PerRay ? "per-ray"
-                                                    : "reference";
+  const char* kernel = c.kernel == Kernel::Tiled       ? "tiled"
+                       : c.kernel == Kernel::TiledSkip ? "tiled+skip"
+                       : c.kernel == Kernel::PerRay    ? "per-ray"
+                                                       : "reference";
   return std::string("scan/") + kernel + "/vol:" + std::to_string(c.volume) +
          (c.frustum > 0 ? "/view:" + std::to_string(c.frustum) : std::string("/light:128")) + "/" +
          visopt::toString(c.precision) + (c.surface ? "/surface" : "/no-surface");
@@ -176,9 +181,15 @@ void runCase(benchmark::State& state, const Case& c) {
     s.behindMax = visopt::FrustumFieldView(*behind, frustum.dims);
   }
   const int64_t rays = int64_t(frustum.dims.x) * frustum.dims.y;
+  visopt::ScanSkipStorage skip;
   auto once = [&] {
     if (c.kernel == Kernel::Reference) return scan(s, rays);
     if (c.kernel == Kernel::Tiled) return visopt::scanTilesOnHost("bench scan", s);
+    if (c.kernel == Kernel::TiledSkip) {  // the skip grid is rebuilt each time, as per iteration
+      visopt::buildScanSkipGrid(f.mu, f.g, s.surfaces, skip);
+      s.skip = skip.grid;
+      return visopt::scanTilesOnHost("bench scan", s);
+    }
     return scan(visopt::FastVisibilityScan<visopt::kScanBufferCells>{s}, rays);
   };
   visopt::ScanSums sums = once();  // first touch of the frustum fields
@@ -245,7 +256,7 @@ std::vector<Case> cases() {
     for (int frustum : {256, 512, 0})
       for (Precision p : {Precision::FP32, Precision::FP16})
         for (bool surface : {false, true})
-          for (Kernel k : {Kernel::Reference, Kernel::PerRay, Kernel::Tiled})
+          for (Kernel k : {Kernel::Reference, Kernel::PerRay, Kernel::Tiled, Kernel::TiledSkip})
             if (full || volume * frustum < 256 * 512)
               out.push_back({k, volume, frustum, p, surface});
   return out;

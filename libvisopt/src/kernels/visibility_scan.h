@@ -30,6 +30,7 @@
 #include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
+#include "kernels/scan_skip.h"
 #include "kernels/screen_weights.h"
 #include "kernels/surface_set.h"
 
@@ -69,6 +70,7 @@ struct VisibilityScan {
   SurfaceSet surfaces;         // opaque context surfaces on the object grid (may be empty)
   ScreenWeights weights;       // view rays only
   FrustumFieldView behindMax;  // optional: max of g behind each cell, on the frustum grid
+  ScanSkipGrid skip;           // optional: empty space for the fast scans (this one ignores it)
 
   // Pixel solid angle (for cell volumes): the tan-plane area over (1 + u^2 + v^2)^(3/2).
   VISOPT_HD float solidAngle(int i, int j) const {

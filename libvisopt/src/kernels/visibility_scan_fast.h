@@ -9,6 +9,8 @@
 //   mu and g for g mu), and each field's precision is branched on once per cell, not per load.
 // - The surfaces are sampled only until the ray is blocked, and only in the front-to-back pass.
 // - exp is evaluated only when the optical depth changed (empty space keeps T).
+// - With a skip grid (kernels/scan_skip.h), cells that can meet neither extinction, importance
+//   nor a surface, and cells behind a surface without importance, load nothing.
 // - With kBufferedCells > 0 the front-to-back pass keeps mu, g and T of each cell in a per-ray
 //   buffer on the stack, so the back-to-front pass samples nothing and T never goes through the
 //   frustum field. The CUDA backend compiles the unbuffered form (kBufferedCells is 0 in device
@@ -21,6 +23,7 @@
 
 #include "core/half.h"
 #include "core/min_max.h"
+#include "kernels/scan_skip.h"
 #include "kernels/visibility_scan.h"
 
 namespace visopt {
@@ -119,17 +122,28 @@ VISOPT_HD VISOPT_INLINE void frontToBack(const VisibilityScan& scan, const ScanR
                     idx.y <= hi.y && idx.z <= hi.z;
     float m = 0.f, g = 0.f, gm = 0.f;  // gm: the interpolated product g_v mu_v
     if (in) {
-      const TrilinearCorners corners(idx, dims);
-      float muC[8], gC[8];
-      corners.load(scan.mu, muC);
-      corners.load(scan.importance, gC);
-      m = corners.interpolate(muC);
-      g = corners.interpolate(gC);
-      if (g > 0.f) gm = corners.interpolateProduct(muC, gC);
-      for (int s = 0; s < scan.surfaces.count && !blocked; ++s) {
-        float phiC[8];
-        corners.load(scan.surfaces.phi[s], phiC);
-        blocked = corners.interpolate(phiC) < 0.f;
+      // What this cell can meet (kernels/scan_skip.h): behind a surface only importance matters.
+      const uint8_t meets = scan.skip.at(idx);
+      const bool important = (meets & kScanHasImportance) != 0;
+      const bool matter = important || (!blocked && (meets & kScanHasExtinction) != 0);
+      const bool surface = !blocked && scan.surfaces.count > 0 && (meets & kScanHasSurface) != 0;
+      if (matter || surface) {
+        const TrilinearCorners corners(idx, dims);
+        if (matter) {
+          float muC[8], gC[8];
+          corners.load(scan.mu, muC);
+          m = corners.interpolate(muC);
+          if (important) {
+            corners.load(scan.importance, gC);
+            g = corners.interpolate(gC);
+            if (g > 0.f) gm = corners.interpolateProduct(muC, gC);
+          }
+        }
+        for (int s = 0; s < scan.surfaces.count && surface && !blocked; ++s) {
+          float phiC[8];
+          corners.load(scan.surfaces.phi[s], phiC);
+          blocked = corners.interpolate(phiC) < 0.f;
+        }
       }
     }
     if (!blocked && opticalDepth != tDepth) {

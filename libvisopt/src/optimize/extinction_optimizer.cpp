@@ -16,6 +16,7 @@
 #include "kernels/visibility_scan_fast.h"
 #include "optimize/level_set.h"
 #include "optimize/narrow_band.h"
+#include "optimize/scan_skip_grid.h"
 #include "visopt/error.h"
 
 namespace visopt {
@@ -41,7 +42,8 @@ ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& 
                   const Field3D& mu, const Field3D& importance, std::optional<Field3D>& d,
                   const char* fieldName, Precision precision, MemoryLedger* ledger,
                   const SurfaceSet& surfaces = {}, const ScreenWeights& weights = {},
-                  std::optional<Field3D>* behindMax = nullptr, const char* maxName = nullptr) {
+                  std::optional<Field3D>* behindMax = nullptr, const char* maxName = nullptr,
+                  const ScanSkipGrid& skip = {}) {
   auto ensure = [&](std::optional<Field3D>& f, const char* fname) {
     const glm::ivec3 storage = frustumStorageDims(frustum.dims);
     if (!f || f->grid().dims != storage) {
@@ -60,6 +62,7 @@ ScanSums scanGrid(const char* name, const FrustumGrid& frustum, const GridSpec& 
   scan.out = FrustumFieldView(*d, frustum.dims);
   scan.surfaces = surfaces;
   scan.weights = weights;
+  scan.skip = skip;
   if (behindMax) {
     ensure(*behindMax, maxName);
     scan.behindMax = FrustumFieldView(**behindMax, frustum.dims);
@@ -178,6 +181,7 @@ struct ExtinctionOptimizer::Level {
   // The side of every surface each voxel lay on when this iteration's level-set steps began
   // (bit set: inside, phi < 0), 64 voxels per word.
   std::vector<DeviceBuffer<uint64_t>> insideAtStart;
+  ScanSkipStorage scanSkip;  // the grid updates' empty space, rebuilt every iteration
 };
 
 ExtinctionOptimizer::ExtinctionOptimizer(MemoryLedger* ledger, Precision precision)
@@ -487,18 +491,20 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
     surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
   const ScreenWeights weights = screenWeightsOf(in);
   auto t0 = Clock::now();
+  buildScanSkipGrid(*p.mu, *p.importance, surfaces, L.scanSkip);
   ScanSums view, light;
   if (p.q != 0.f || hasSurfaces)
     view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, L.dView,
                     "view-derivative", precision_, ledger_, surfaces, weights,
-                    ghatNeeded ? &L.viewMax : nullptr, "view-importance-behind");
+                    ghatNeeded ? &L.viewMax : nullptr, "view-importance-behind", L.scanSkip.grid);
   else
     L.dView.reset();
   if (abandonRequested()) return std::nullopt;  // nothing but scratch has changed yet
   if (lightGrids)
-    light = scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
-                     "light-derivative", precision_, ledger_, surfaces, ScreenWeights{},
-                     ghatNeeded ? &L.lightMax : nullptr, "light-importance-behind");
+    light =
+        scanGrid("grid updates: light", p.light, p.grid, *p.mu, *p.importance, L.dLight,
+                 "light-derivative", precision_, ledger_, surfaces, ScreenWeights{},
+                 ghatNeeded ? &L.lightMax : nullptr, "light-importance-behind", L.scanSkip.grid);
   else
     L.lightMax.reset();
   st.gridUpdatesMs = msSince(t0);

@@ -22,6 +22,7 @@
 #include "core/field_view.h"
 #include "core/hd.h"
 #include "core/min_max.h"
+#include "core/voxel_ijk.h"
 #include "kernels/surface_set.h"
 
 namespace visopt {
@@ -45,8 +46,6 @@ struct ScanSkipGrid {
   glm::ivec3 bricks{0};
   glm::ivec3 voxels{0};
 
-  VISOPT_HD bool valid() const { return flags != nullptr; }
-
   // The flags of the brick holding the lower trilinear corner of index position p (clamped to
   // the grid as TrilinearCorners clamps); everything when there is no grid.
   VISOPT_HD VISOPT_INLINE uint8_t at(glm::vec3 p) const {
@@ -66,8 +65,7 @@ struct ScanSkipOwnFlags {
   uint8_t* own = nullptr;
 
   VISOPT_HD void operator()(int64_t brick) const {
-    const int bx = int(brick % bricks.x), by = int((brick / bricks.x) % bricks.y),
-              bz = int(brick / (int64_t(bricks.x) * bricks.y));
+    const auto [bx, by, bz] = voxelIjk(brick, bricks);
     const glm::ivec3 lo = glm::ivec3(bx, by, bz) * kScanSkipBrick;
     const glm::ivec3 hi = glm::min(lo + kScanSkipBrick, mu.dims);
     bool extinction = false, important = false, surface = false;
@@ -95,8 +93,7 @@ struct ScanSkipDilate {
   uint8_t* flags = nullptr;
 
   VISOPT_HD void operator()(int64_t brick) const {
-    const int bx = int(brick % bricks.x), by = int((brick / bricks.x) % bricks.y),
-              bz = int(brick / (int64_t(bricks.x) * bricks.y));
+    const auto [bx, by, bz] = voxelIjk(brick, bricks);
     uint8_t f = 0;
     for (int dz = 0; dz < 2 && bz + dz < bricks.z; ++dz)
       for (int dy = 0; dy < 2 && by + dy < bricks.y; ++dy)

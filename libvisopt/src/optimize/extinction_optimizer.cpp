@@ -491,9 +491,10 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
     surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
   const ScreenWeights weights = screenWeightsOf(in);
   auto t0 = Clock::now();
-  buildScanSkipGrid(*p.mu, *p.importance, surfaces, L.scanSkip);
+  const bool viewScan = p.q != 0.f || hasSurfaces;
+  if (viewScan || lightGrids) buildScanSkipGrid(*p.mu, *p.importance, surfaces, L.scanSkip);
   ScanSums view, light;
-  if (p.q != 0.f || hasSurfaces)
+  if (viewScan)
     view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, L.dView,
                     "view-derivative", precision_, ledger_, surfaces, weights,
                     ghatNeeded ? &L.viewMax : nullptr, "view-importance-behind", L.scanSkip.grid);

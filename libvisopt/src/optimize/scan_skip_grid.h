@@ -14,7 +14,6 @@ namespace visopt {
 struct ScanSkipStorage {
   DeviceBuffer<uint8_t> own, flags;
   ScanSkipGrid grid;
-  size_t bytes() const { return own.bytes() + flags.bytes(); }
 };
 
 // mu, importance and the surfaces' phi on one grid (otherwise out.grid is left empty: no skipping).

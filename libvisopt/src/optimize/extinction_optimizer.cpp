@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <span>
 
 #include "core/brick_order.h"
 #include "core/device_buffer.h"
@@ -14,6 +15,7 @@
 #include "host/visibility_scan_tiles.h"
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan_fast.h"
+#include "optimize/level_end.h"
 #include "optimize/level_set.h"
 #include "optimize/narrow_band.h"
 #include "optimize/scan_skip_grid.h"
@@ -863,37 +865,17 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
   std::vector<IterationStats> all;
   for (int l = 0; l < s.levels; ++l) {
     buildLevel(in, s, l, s.levels);
-    double last = 0.0;
-    std::optional<IterationStats> previous;
+    const size_t levelStart = all.size();
     for (int it = 0; it < s.maxIterationsPerLevel; ++it) {
       const std::optional<IterationStats> done =
           runIteration(in, s, s.levels, s.maxIterationsPerLevel);
       if (!done) return all;
-      const IterationStats& st = *done;
-      all.push_back(st);
-      if (callback && !callback(st)) return all;
+      all.push_back(*done);
+      if (callback && !callback(*done)) return all;
       if (cutShort_) return all;
-      const double e = st.energy();
-      const double rel = std::abs(e - last) / std::max(std::abs(e), 1e-30);
-      last = e;
-      // A level ends when the energy has settled and the surfaces have (the energy alone can
-      // stall while a surface is still on its way through an unimportant layer): they moved by
-      // less than a tenth of a voxel in the last iteration, or where they lie stopped changing.
-      // levelSetMotionVoxels bounds the motion by the largest change of any substep, so it
-      // also counts churn that goes nowhere: where the advection term (grad ghat . grad phi)
-      // pushes a surface out each substep and redistancing and the return term pull it back,
-      // it stays near a voxel per iteration at a standstill (builtin:ct-head: 0.9 voxel per
-      // iteration for 40 iterations while the deviation from the base stayed 0.057 voxel on
-      // average and 1.09 at most, to the third decimal). A surface on its way changes how far
-      // it lies from its base: both deviation statistics steady from one iteration to the next
-      // is a standstill.
-      const bool deviationSteady =
-          previous && std::abs(st.meanDeviationVoxels - previous->meanDeviationVoxels) < 0.002 &&
-          std::abs(st.maxDeviationVoxels - previous->maxDeviationVoxels) < 0.1;
-      const bool surfacesSettled = st.levelSetMotionVoxels < 0.1 || deviationSteady;
       level_->ghatFixed = true;
-      previous = st;
-      if (it + 1 >= s.minIterationsPerLevel && rel < s.tolerance && surfacesSettled) break;
+      // optimize/level_end.h: converged, or circling without progress.
+      if (levelSettled(std::span(all).subspan(levelStart), s)) break;
     }
   }
   return all;

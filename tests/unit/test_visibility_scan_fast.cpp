@@ -35,8 +35,10 @@ struct Case {
   Weights weights;
   bool lightFrustum;
   bool behindMax;
-  bool mixedImportance = false;  // g in fp32 whatever the others' precision
-  bool sparse = false;           // mu only in a ball, empty space around it
+  bool mixedImportance = false;       // g in fp32 whatever the others' precision
+  bool sparse = false;                // mu only in a ball, empty space around it
+  bool importanceEverywhere = false;  // g in every voxel, up to the volume's faces
+  bool eyeInside = false;             // the camera inside the volume
   std::string name() const {
     return std::string(precision == Precision::FP16 ? "fp16" : "fp32") + "_surfaces" +
            std::to_string(surfaces) +
@@ -72,7 +74,9 @@ Scene makeScene(const Case& c) {
         const glm::vec3 x = s.grid.origin + glm::vec3(i, j, k) * s.grid.spacing;
         const bool empty = (i > 15 && i < 19) || (c.sparse && glm::length(x) > 0.36f);
         s.mu.set(v, empty ? 0.f : 6.f * u(rng));
-        s.g.set(v, glm::length(x - glm::vec3(0.1f, 0.f, 0.05f)) < 0.3f ? u(rng) : 0.f);
+        const bool important =
+            c.importanceEverywhere || glm::length(x - glm::vec3(0.1f, 0.f, 0.05f)) < 0.3f;
+        s.g.set(v, important ? u(rng) : 0.f);
       }
   const glm::vec3 centres[2] = {{-0.2f, 0.05f, 0.f}, {0.15f, -0.1f, 0.1f}};
   for (int sIdx = 0; sIdx < c.surfaces; ++sIdx) {
@@ -91,7 +95,7 @@ Scene makeScene(const Case& c) {
     s.frustum = FrustumGrid::forLight(light, bounds, glm::ivec3(21, 21, 0), s.grid.minSpacing());
   } else {
     Camera cam;
-    cam.eye = glm::vec3(0.4f, -2.1f, 0.7f);
+    cam.eye = c.eyeInside ? glm::vec3(0.05f, -0.1f, 0.02f) : glm::vec3(0.4f, -2.1f, 0.7f);
     cam.target = glm::vec3(0.02f, 0.01f, -0.03f);
     s.frustum = FrustumGrid::forCamera(cam, 26, 20, bounds, 0, s.grid.minSpacing());
   }
@@ -207,6 +211,26 @@ TEST(FastVisibilityScan, MatchesTheReferenceScan) {
           ++cases;
         }
   EXPECT_EQ(cases, 36);
+}
+
+// Each ray is bounded to the volume before its cells are walked (cellsInVolume): with importance
+// up to the volume's faces the cells where a ray enters and leaves count, from outside the volume
+// (rays entering through faces, edges and corners, and rays missing it), from the light, and from
+// a camera inside the volume.
+TEST(FastVisibilityScan, RaysBoundedToTheVolumeKeepTheCellsAtItsFaces) {
+  for (Precision p : {Precision::FP32, Precision::FP16})
+    for (int view : {0, 1, 2}) {
+      Case c{p, 0, Weights::None, view == 1, true};
+      c.importanceEverywhere = true;
+      c.eyeInside = view == 2;
+      const Scene s = makeScene(c);
+      SCOPED_TRACE(c.eyeInside ? "eye inside" : "eye outside");
+      const Result ref = run<VisibilityScan>(s, c);
+      expectSame(ref, run<FastVisibilityScan<kScanBufferCells>>(s, c), c, "buffered");
+      expectSame(ref, run<FastVisibilityScan<0>>(s, c), c, "unbuffered");
+      expectSame(ref, run<TiledScan>(s, c), c, "tiled");
+      expectSame(ref, run<TiledScan>(s, c, true), c, "tiled, skipping");
+    }
 }
 
 // Fields of mixed precision: the tiled scan's per-ray front-to-back pass (its lanes pass needs

@@ -29,11 +29,10 @@ int endsAt(const std::vector<IterationStats>& seq, const ExtinctionSettings& s =
 
 // The Cranium CT's coarsest level (README command), iterations 31-37 of its cycle: energy,
 // mean and largest deviation (voxels), motion bound (voxels per iteration).
-constexpr double kCtCycle[7][4] = {
-    {-596904, 0.0412, 1.672, 4.555}, {-598725, 0.0411, 1.638, 5.246},
-    {-598953, 0.0516, 1.660, 4.286}, {-600564, 0.0491, 1.620, 5.369},
-    {-600497, 0.0357, 1.585, 4.567}, {-597814, 0.0324, 1.646, 3.152},
-    {-595443, 0.0463, 1.660, 3.757}};
+constexpr double kCtCycle[7][4] = {{-596904, 0.0412, 1.672, 4.555}, {-598725, 0.0411, 1.638, 5.246},
+                                   {-598953, 0.0516, 1.660, 4.286}, {-600564, 0.0491, 1.620, 5.369},
+                                   {-600497, 0.0357, 1.585, 4.567}, {-597814, 0.0324, 1.646, 3.152},
+                                   {-595443, 0.0463, 1.660, 3.757}};
 
 std::vector<IterationStats> ctCycle(int iterations, double driftPerIteration) {
   std::vector<IterationStats> seq;
@@ -76,7 +75,8 @@ TEST(LevelEnd, EndsInTheCraniumCtsLimitCycle) {
   // passes (the energy changes by up to 0.45 % per iteration), the cycle test does once two
   // windows of it have run.
   const std::vector<IterationStats> seq = ctCycle(60, 1.2e-4 / 7.0);
-  for (size_t n = 1; n <= seq.size(); ++n) EXPECT_FALSE(levelConverged(std::span(seq).first(n), {}));
+  for (size_t n = 1; n <= seq.size(); ++n)
+    EXPECT_FALSE(levelConverged(std::span(seq).first(n), {}));
   EXPECT_EQ(endsAt(seq), 2 * kLevelCycleWindow);
 }
 

@@ -298,7 +298,6 @@ void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   });
 }
 
-// Substeps of the level-set step per iteration on `level` (LevelSetSettings::reach).
 // The lens and windowing mask of the view rays (Himmler & Günther 2026, §III-F, Fig. 8).
 ScreenWeights screenWeightsOf(const OptimizationInputs& in) {
   ScreenWeights weights;
@@ -317,6 +316,7 @@ ScreenWeights screenWeightsOf(const OptimizationInputs& in) {
 // settled (level_set.h: redistance).
 constexpr float kRedistanceStopBand = 3.f;
 
+// Substeps of the level-set step per iteration on `level` (LevelSetSettings::reach).
 int levelSetSubsteps(const OptimizationInputs& in, const ExtinctionSettings& s,
                      const GridSpec& level, int cap) {
   const LevelSetSettings& ls = in.levelSet;

@@ -26,9 +26,6 @@ QImage toQImage(const Image& image) {
 
 // Frames during optimisation: at most this often, so most of the time goes to iterating.
 constexpr int kFrameIntervalMs = 400;
-// Continuous optimisation stops iterating (until something changes) once the relative energy
-// change stayed below the level tolerance for this many iterations.
-constexpr int kConvergedIterations = 5;
 // Longest side of the image the optimisation's frustum grids are sized for while following the
 // camera: 128 view rays per side (frustumScale 0.5), about one per voxel column of a 128^3 scene.
 constexpr int kOptimizationSide = 256;
@@ -237,7 +234,7 @@ void EngineController::runTask(Engine& engine, Task& task) {
     deliver([this, msg] { emit errorOccurred(msg); });
   }
   if (task.isLong) deliver([this, ok] { emit longWorkFinished(ok); });
-  followIterations_ = 0;
+  follow_.reset();
   std::lock_guard lock(mutex_);
   frameOwed_ = true;
   converged_ = false;
@@ -300,7 +297,7 @@ void EngineController::optimizeStep(Engine& engine) {
     restartPending_ = false;
   }
   const auto settle = [this] {
-    quietIterations_ = followIterations_ = 0;
+    follow_.reset();
     converged_ = true;
     deliver([this] { emit convergedChanged(true); });
   };
@@ -330,14 +327,9 @@ void EngineController::optimizeStep(Engine& engine) {
   const auto stats = engine.continueOptimization(1, {}, interrupt);
   if (stats.empty()) return;  // abandoned
   report(stats.back());
-  const double e = stats.back().energy();
-  const double rel = std::abs(e - lastEnergy_) / std::max(std::abs(e), 1e-30);
-  lastEnergy_ = e;
-  quietIterations_ = rel < engine.extinctionSettings().tolerance ? quietIterations_ + 1 : 0;
-  // Following the camera: stop when the energy is still, or after a level's iteration budget.
-  if (quietIterations_ >= kConvergedIterations ||
-      ++followIterations_ >= engine.extinctionSettings().maxIterationsPerLevel)
-    settle();
+  // Following the camera: stop when the energy is still, circles without progress, or after a
+  // level's iteration budget (follow_convergence.h).
+  if (follow_.add(stats.back(), engine.extinctionSettings())) settle();
   std::lock_guard lock(mutex_);
   frameOwed_ = true;
 }
@@ -387,7 +379,7 @@ void EngineController::workerLoop() {
       frameOwed_ = previewShown_ = false;
       continue;
     }
-    if (cameraChanged) followIterations_ = 0;
+    if (cameraChanged) follow_.reset();
     try {
       if (cameraChanged) engine.setCamera(cam);
       // The frustum grids follow the image's shape, not its pixel count: a large window would

@@ -22,6 +22,7 @@
 
 #include <visopt/engine.h>
 
+#include "follow_convergence.h"
 #include "scene_snapshot.h"
 
 namespace visopt::ws {
@@ -131,9 +132,7 @@ class EngineController : public QObject {
   bool restartPending_ = true;  // next optimisation step runs the multigrid schedule
   int itersSinceFrame_ = 0;
   // Worker-only: convergence while following the camera.
-  double lastEnergy_ = 0.0;
-  int quietIterations_ = 0;
-  int followIterations_ = 0;
+  FollowConvergence follow_;
   QElapsedTimer sinceFrame_;
 
   std::shared_ptr<const SceneSnapshot> snapshot_;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -81,5 +82,12 @@ struct IterationStats {
   double maxDeviationVoxels = 0.0;  // |phi0| on the current surface, over surface voxels
   double meanDeviationVoxels = 0.0;
 };
+
+// True when a level's iterations so far (oldest first) circle in a limit cycle without progress:
+// over the last 8 the energy moves more back and forth than forward and gains less than ten
+// times the tolerance per iteration, and the surfaces' deviation from their base shows no trend.
+// ExtinctionOptimizer::optimize ends a level on it (besides convergence); a caller iterating on
+// its own (the workstation following the camera) can ask the same.
+bool levelInCycle(std::span<const IterationStats> level, const ExtinctionSettings& s);
 
 }  // namespace visopt

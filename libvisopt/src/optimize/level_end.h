@@ -26,7 +26,7 @@ inline constexpr int kLevelCycleWindow = 8;
 
 // `level`: this level's iterations so far, oldest first.
 bool levelConverged(std::span<const IterationStats> level, const ExtinctionSettings& s);
-bool levelInCycle(std::span<const IterationStats> level, const ExtinctionSettings& s);
+// levelInCycle: visopt/optimization.h.
 inline bool levelSettled(std::span<const IterationStats> level, const ExtinctionSettings& s) {
   return levelConverged(level, s) || levelInCycle(level, s);
 }

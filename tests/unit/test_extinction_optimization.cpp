@@ -123,6 +123,28 @@ TEST(ExtinctionOptimization, LightGridsExistOnlyWhenTheLightTermIsOn) {
   EXPECT_TRUE(hasField("light-derivative"));
 }
 
+// The grid updates' empty-space skip grid (optimize/scan_skip_grid.h) is listed in the ledger
+// with its bytes: two bytes per brick of 4^3 voxels.
+TEST(ExtinctionOptimization, TheSkipGridIsInTheLedger) {
+  Engine e;
+  loadOccluderScene(e);
+  ExtinctionSettings s = quickSettings();
+  s.levels = 1;
+  s.maxIterationsPerLevel = 2;
+  e.setExtinctionSettings(s);
+  e.optimize();
+  const glm::ivec3 d = e.volume().normalized.grid().dims;
+  const size_t bricks = size_t((d.x + 3) / 4) * size_t((d.y + 3) / 4) * size_t((d.z + 3) / 4);
+  int found = 0;
+  for (const auto& entry : e.ledger().entries())
+    if (entry.name == "scan-skip-grid") {
+      ++found;
+      EXPECT_EQ(entry.bytes, 2 * bricks);
+      EXPECT_EQ(entry.precision, "u8");
+    }
+  EXPECT_EQ(found, 1);
+}
+
 TEST(ExtinctionOptimization, WarmStartFollowsTheCameraAndFreezingKeepsMu) {
   Engine e;
   loadOccluderScene(e);

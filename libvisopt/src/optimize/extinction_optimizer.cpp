@@ -494,7 +494,8 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
   const ScreenWeights weights = screenWeightsOf(in);
   auto t0 = Clock::now();
   const bool viewScan = p.q != 0.f || hasSurfaces;
-  if (viewScan || lightGrids) buildScanSkipGrid(*p.mu, *p.importance, surfaces, L.scanSkip);
+  if (viewScan || lightGrids)
+    buildScanSkipGrid(*p.mu, *p.importance, surfaces, L.scanSkip, ledger_);
   ScanSums view, light;
   if (viewScan)
     view = scanGrid("grid updates: view", p.view, p.grid, *p.mu, *p.importance, L.dView,

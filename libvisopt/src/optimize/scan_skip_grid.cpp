@@ -5,7 +5,7 @@
 namespace visopt {
 
 void buildScanSkipGrid(const Field3D& mu, const Field3D& importance, const SurfaceSet& surfaces,
-                       ScanSkipStorage& out) {
+                       ScanSkipStorage& out, MemoryLedger* ledger) {
   const glm::ivec3 voxels = mu.grid().dims;
   bool sameGrid = importance.grid().dims == voxels;
   for (int s = 0; s < surfaces.count; ++s) sameGrid = sameGrid && surfaces.phi[s].dims == voxels;
@@ -18,6 +18,7 @@ void buildScanSkipGrid(const Field3D& mu, const Field3D& importance, const Surfa
   if (out.flags.size() != size_t(n)) {
     out.own = DeviceBuffer<uint8_t>(size_t(n));
     out.flags = DeviceBuffer<uint8_t>(size_t(n));
+    out.registered = LedgerRegistration(ledger, "scan-skip-grid", 2 * size_t(n), "u8");
   }
   exec::parallelFor(
       "grid updates: skip grid", n,

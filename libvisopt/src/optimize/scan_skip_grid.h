@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "core/device_buffer.h"
+#include "core/ledger_registration.h"
 #include "kernels/scan_skip.h"
 #include "kernels/surface_set.h"
 #include "visopt/field.h"
@@ -14,10 +15,12 @@ namespace visopt {
 struct ScanSkipStorage {
   DeviceBuffer<uint8_t> own, flags;
   ScanSkipGrid grid;
+  LedgerRegistration registered;  // "scan-skip-grid": both buffers' bytes
 };
 
 // mu, importance and the surfaces' phi on one grid (otherwise out.grid is left empty: no skipping).
+// The buffers are listed in `ledger` (may be null) while they exist.
 void buildScanSkipGrid(const Field3D& mu, const Field3D& importance, const SurfaceSet& surfaces,
-                       ScanSkipStorage& out);
+                       ScanSkipStorage& out, MemoryLedger* ledger = nullptr);
 
 }  // namespace visopt

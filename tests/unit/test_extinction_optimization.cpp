@@ -32,6 +32,14 @@ ExtinctionSettings quickSettings() {
   return s;
 }
 
+// Enough to allocate every grid an optimisation needs.
+ExtinctionSettings twoIterationsAtOneLevel() {
+  ExtinctionSettings s = quickSettings();
+  s.levels = 1;
+  s.maxIterationsPerLevel = 2;
+  return s;
+}
+
 }  // namespace
 
 TEST(ExtinctionOptimization, WithoutImportanceTheOptimumIsMuBar) {
@@ -104,9 +112,7 @@ TEST(ExtinctionOptimization, LightTermLightsTheBlob) {
 TEST(ExtinctionOptimization, LightGridsExistOnlyWhenTheLightTermIsOn) {
   Engine e;
   loadOccluderScene(e);
-  ExtinctionSettings s = quickSettings();
-  s.levels = 1;
-  s.maxIterationsPerLevel = 2;
+  ExtinctionSettings s = twoIterationsAtOneLevel();
   auto hasField = [&](const std::string& name) {
     for (const auto& entry : e.ledger().entries())
       if (entry.name == name) return true;
@@ -128,9 +134,7 @@ TEST(ExtinctionOptimization, LightGridsExistOnlyWhenTheLightTermIsOn) {
 TEST(ExtinctionOptimization, TheSkipGridIsInTheLedger) {
   Engine e;
   loadOccluderScene(e);
-  ExtinctionSettings s = quickSettings();
-  s.levels = 1;
-  s.maxIterationsPerLevel = 2;
+  ExtinctionSettings s = twoIterationsAtOneLevel();
   e.setExtinctionSettings(s);
   e.optimize();
   const glm::ivec3 d = e.volume().normalized.grid().dims;

@@ -11,6 +11,7 @@
 
 #include "core/bit_mask_view.h"
 #include "core/device_buffer.h"
+#include "core/ledger_registration.h"
 #include "visopt/bit_mask.h"
 #include "visopt/memory_ledger.h"
 
@@ -20,17 +21,13 @@ class DeviceBitMask {
  public:
   // All clear.
   DeviceBitMask(glm::ivec3 dims, const std::string& name, MemoryLedger* ledger)
-      : dims_(dims), words_(wordCount(dims)), ledger_(ledger) {
+      : dims_(dims), words_(wordCount(dims)), registered_(ledger, name, words_.bytes(), "bit") {
     if (words_.size()) std::memset(words_.data(), 0, words_.size());
-    if (ledger_) token_ = ledger_->add(name, words_.bytes(), "bit");
   }
   DeviceBitMask(const BitMask& mask, const std::string& name, MemoryLedger* ledger)
       : DeviceBitMask(mask.dims, name, ledger) {
     const size_t n = mask.bits.size() < words_.size() ? mask.bits.size() : words_.size();
     if (n) std::memcpy(words_.data(), mask.bits.data(), n);
-  }
-  ~DeviceBitMask() {
-    if (ledger_ && token_) ledger_->remove(token_);
   }
   DeviceBitMask(const DeviceBitMask&) = delete;
   DeviceBitMask& operator=(const DeviceBitMask&) = delete;
@@ -53,8 +50,7 @@ class DeviceBitMask {
  private:
   glm::ivec3 dims_;
   DeviceBuffer<uint8_t> words_;
-  MemoryLedger* ledger_ = nullptr;
-  int token_ = 0;
+  LedgerRegistration registered_;
 };
 
 }  // namespace visopt

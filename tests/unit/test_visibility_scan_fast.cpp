@@ -16,6 +16,7 @@
 #include "core/frustum_field.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "host/visibility_scan_packet.h"
 #include "host/visibility_scan_tiles.h"
 #include "kernels/visibility_scan_fast.h"
 #include "optimize/scan_skip_grid.h"
@@ -233,14 +234,28 @@ TEST(FastVisibilityScan, RaysBoundedToTheVolumeKeepTheCellsAtItsFaces) {
     }
 }
 
-// Fields of mixed precision: the tiled scan's per-ray front-to-back pass (its lanes pass needs
-// one precision throughout).
+// Fields of mixed precision: the tiled scan's per-ray front-to-back pass (the packet pass needs
+// one precision throughout, and the dispatch sends fields of one precision to it).
 TEST(FastVisibilityScan, MixedPrecisionMatchesTheReferenceScan) {
   for (int surfaces : {0, 2}) {
     Case c{Precision::FP16, surfaces, Weights::Lens, false, true};
     c.mixedImportance = true;
     const Scene s = makeScene(c);
     expectSame(run<VisibilityScan>(s, c), run<TiledScan>(s, c), c, "tiled, mixed precision");
+
+    VisibilityScan scan;
+    scan.mu = FieldView(s.mu);
+    scan.importance = FieldView(s.g);
+    scan.surfaces.count = surfaces;
+    for (int i = 0; i < surfaces; ++i) scan.surfaces.phi[i] = FieldView(s.phi[i]);
+    EXPECT_FALSE(packetScanApplies<float>(scan));
+    EXPECT_FALSE(packetScanApplies<Half>(scan));
+    const Scene same = makeScene(Case{Precision::FP16, surfaces, Weights::Lens, false, true});
+    scan.importance = FieldView(same.g);
+    scan.mu = FieldView(same.mu);
+    for (int i = 0; i < surfaces; ++i) scan.surfaces.phi[i] = FieldView(same.phi[i]);
+    EXPECT_TRUE(packetScanApplies<Half>(scan));
+    EXPECT_FALSE(packetScanApplies<float>(scan));
   }
 }
 

@@ -8,6 +8,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "exec/parallel.h"
+#include "host/visibility_scan_packet.h"
 #include "kernels/visibility_scan_fast.h"
 #include "visopt/error.h"
 
@@ -26,6 +27,30 @@ struct TileBuffer {
   }
 };
 
+// The front-to-back pass ray by ray (kernels/visibility_scan_fast.h) into the tile's rows: for
+// fields of mixed precision, which the packet pass does not take.
+void frontToBackLanes(const VisibilityScan& scan, const RayPacket& rays, ScanSums& sums, float* bm,
+                      float* bg, float* bt) {
+  const FrustumFieldView& out = scan.out;
+  const int nz = scan.frustum.dims.z;
+  for (int lane = 0; lane < kTileRays; ++lane) {
+    if (lane >= rays.lanes) {  // past the frustum's edge: zeros, stored into the tile's padding
+      for (int k = 0; k < nz; ++k)
+        bm[k * kTileRays + lane] = bg[k * kTileRays + lane] = bt[k * kTileRays + lane] = 0.f;
+      continue;
+    }
+    const ScanRay ray{
+        rays.o, {rays.dx[lane], rays.dy[lane], rays.dz[lane]}, rays.w[lane], rays.omega[lane]};
+    frontToBack(scan, ray, sums, [&](int k, float m, float g, float t) {
+      const size_t c = size_t(k) * kTileRays + size_t(lane);
+      bm[c] = m;
+      bg[c] = g;
+      // What the reference reads back from the frustum field (fp16 rounds it).
+      bt[c] = out.half() ? halfToFloat(floatToHalf(t)) : t;
+    });
+  }
+}
+
 ScanSums scanTile(const VisibilityScan& scan, int64_t tile, TileBuffer& buf) {
   const FrustumMap& f = scan.frustum;
   const FrustumFieldView& out = scan.out;
@@ -38,24 +63,26 @@ ScanSums scanTile(const VisibilityScan& scan, int64_t tile, TileBuffer& buf) {
   float* bt = buf.t.data();
 
   ScanSums sums;
-  float w[kTileRays] = {}, omega[kTileRays] = {};
-  for (int lane = 0; lane < kTileRays; ++lane) {
-    if (lane >= lanes) {  // past the frustum's edge: zeros, stored into the tile's padding
-      for (int k = 0; k < nz; ++k)
-        bm[k * kTileRays + lane] = bg[k * kTileRays + lane] = bt[k * kTileRays + lane] = 0.f;
-      continue;
-    }
+  RayPacket rays;
+  rays.lanes = lanes;
+  for (int lane = 0; lane < lanes; ++lane) {
     const ScanRay ray = scanRayOf(scan, i0 + lane, j);
-    w[lane] = ray.w;
-    omega[lane] = ray.omega;
-    frontToBack(scan, ray, sums, [&](int k, float m, float g, float t) {
-      const size_t c = size_t(k) * kTileRays + size_t(lane);
-      bm[c] = m;
-      bg[c] = g;
-      // What the reference reads back from the frustum field (fp16 rounds it).
-      bt[c] = out.half() ? halfToFloat(floatToHalf(t)) : t;
-    });
+    rays.o = ray.o;
+    rays.dx[lane] = ray.d.x;
+    rays.dy[lane] = ray.d.y;
+    rays.dz[lane] = ray.d.z;
+    rays.w[lane] = ray.w;
+    rays.omega[lane] = ray.omega;
+    rays.active[lane] = 1;
   }
+  if (packetScanApplies<float>(scan))
+    frontToBackPacket<float>(scan, rays, sums, bm, bg, bt);
+  else if (packetScanApplies<Half>(scan))
+    frontToBackPacket<Half>(scan, rays, sums, bm, bg, bt);
+  else
+    frontToBackLanes(scan, rays, sums, bm, bg, bt);
+  const float* w = rays.w;
+  const float* omega = rays.omega;
 
   // Back to front, the tile's rays in lanes: G (behind, weighted by s^2) and d = g T - G.
   const float ds = f.ds;

@@ -6,7 +6,10 @@
 #include <tbb/parallel_reduce.h>
 
 #include "core/field_access.h"
+#include "core/frustum_field.h"
+#include "core/min_max.h"
 #include "exec/parallel.h"
+#include "host/simd_gather.h"
 
 namespace visopt {
 namespace {
@@ -30,6 +33,51 @@ VISOPT_INLINE glm::vec3 toGridSelect(const FrustumMap& f, glm::vec3 x) {
   return glm::vec3(front ? gx : -1e30f, front ? gy : -1e30f, front ? gz : -1e30f);
 }
 
+// FrustumFieldView::inside and ::sample at kLanes positions (0 outside the grid and in lanes
+// n and up), in sample's order of operations; the eight corners of all lanes are gathered
+// together (host/simd_gather.h).
+template <class Storage>
+void sampleLanes(const FrustumFieldView& d, const float* x, const float* y, const float* z, int n,
+                 float* out) {
+  const glm::ivec3 dims = d.dims;
+  const int nz = dims.z, tilesX = d.tilesX;
+  const float hx = float(dims.x) - 0.5f, hy = float(dims.y) - 0.5f, hz = float(dims.z) - 0.5f;
+  alignas(64) int corner[8][kLanes], in[kLanes];
+  alignas(64) float fx[kLanes], fy[kLanes], fz[kLanes], v[8][kLanes];
+  auto index = [&](int i, int j, int k) {
+    return ((j * tilesX + i / kTileRays) * nz + k) * kTileRays + i % kTileRays;
+  };
+  for (int l = 0; l < kLanes; ++l) {
+    in[l] = (l < n) & (x[l] >= -0.5f) & (y[l] >= -0.5f) & (z[l] >= -0.5f) & (x[l] <= hx) &
+            (y[l] <= hy) & (z[l] <= hz);
+    // Lanes outside sample the grid's first cell (maxOf(NaN, 0) is 0) and are discarded below.
+    const float px = in[l] ? minOf(maxOf(x[l], 0.f), float(dims.x - 1)) : 0.f;
+    const float py = in[l] ? minOf(maxOf(y[l], 0.f), float(dims.y - 1)) : 0.f;
+    const float pz = in[l] ? minOf(maxOf(z[l], 0.f), float(dims.z - 1)) : 0.f;
+    const int i0 = int(px), j0 = int(py), k0 = int(pz);
+    const int i1 = i0 + 1 < dims.x ? i0 + 1 : i0, j1 = j0 + 1 < dims.y ? j0 + 1 : j0;
+    const int dk = k0 + 1 < dims.z ? kTileRays : 0;
+    fx[l] = px - float(i0), fy[l] = py - float(j0), fz[l] = pz - float(k0);
+    corner[0][l] = index(i0, j0, k0), corner[1][l] = index(i1, j0, k0);
+    corner[2][l] = index(i0, j1, k0), corner[3][l] = index(i1, j1, k0);
+    for (int c = 0; c < 4; ++c) corner[c + 4][l] = corner[c][l] + dk;
+  }
+  for (int c = 0; c < 8; ++c) gatherLanes<Storage>(d.storage.data, corner[c], v[c]);
+  for (int l = 0; l < kLanes; ++l) {
+    const float a00 = v[0][l] + fx[l] * (v[1][l] - v[0][l]);
+    const float a10 = v[2][l] + fx[l] * (v[3][l] - v[2][l]);
+    const float a01 = v[4][l] + fx[l] * (v[5][l] - v[4][l]);
+    const float a11 = v[6][l] + fx[l] * (v[7][l] - v[6][l]);
+    const float a0 = a00 + fy[l] * (a10 - a00), a1 = a01 + fy[l] * (a11 - a01);
+    out[l] = in[l] ? a0 + fz[l] * (a1 - a0) : 0.f;
+  }
+}
+
+// Whether a frustum field's cells can be gathered with 32-bit indices.
+bool gathersInLanes(const FrustumFieldView& d) {
+  return d.storage.size() < (size_t(1) << 31);
+}
+
 // One row's chunk of n <= kLanes voxels starting at voxel index v0 = (j, k) row's i0.
 template <class A, bool kAdemamix>
 struct RowStep {
@@ -41,23 +89,21 @@ struct RowStep {
     const ExtinctionGradient& grad = step.gradient;
     const OptimizerCoefficients& c = step.coefficients;
     // The voxels' positions in the frusta (vectorised).
-    float vx[kLanes], vy[kLanes], vz[kLanes], lx[kLanes], ly[kLanes], lz[kLanes];
+    alignas(64) float vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, lx[kLanes] = {},
+                      ly[kLanes] = {}, lz[kLanes] = {};
     for (int l = 0; l < n; ++l) {
       const glm::vec3 x = grad.volume.toWorld(glm::vec3(float(i0 + l), float(j), float(k)));
       const glm::vec3 yv = toGridSelect(grad.view, x), yl = toGridSelect(grad.light, x);
       vx[l] = yv.x, vy[l] = yv.y, vz[l] = yv.z;
       lx[l] = yl.x, ly[l] = yl.y, lz[l] = yl.z;
     }
-    // d_V, d_L and mu_bar: gathers, one voxel at a time (gatherFrustum's rules).
-    float dv[kLanes], dl[kLanes], mbar[kLanes];
+    // d_V and d_L (gatherFrustum's rules; a term that is off has d = 0) and mu_bar.
+    alignas(64) float dv[kLanes] = {}, dl[kLanes] = {}, mbar[kLanes];
     const bool viewOn = grad.q != 0.f && grad.dView.valid();
     const bool lightOn = grad.r != 0.f && grad.dLight.valid();
-    for (int l = 0; l < n; ++l) {
-      const glm::vec3 yv(vx[l], vy[l], vz[l]), yl(lx[l], ly[l], lz[l]);
-      dv[l] = viewOn && grad.dView.inside(yv) ? grad.dView.sample(yv) : 0.f;
-      dl[l] = lightOn && grad.dLight.inside(yl) ? grad.dLight.sample(yl) : 0.f;
-      mbar[l] = grad.base.at(v0 + size_t(l));
-    }
+    gather(grad.dView, viewOn, vx, vy, vz, n, dv);
+    gather(grad.dLight, lightOn, lx, ly, lz, n, dl);
+    for (int l = 0; l < n; ++l) mbar[l] = grad.base.at(v0 + size_t(l));
     // The gradient (ExtinctionGradient::at; a term that is off has d = 0 and adds nothing) and
     // the optimiser step (kernels/optimizer_update.h), vectorised. The sums go to local lanes
     // first: the caller's arrays might alias the fields as far as the compiler can tell.
@@ -78,6 +124,23 @@ struct RowStep {
     for (int l = 0; l < kLanes; ++l) {
       energy[l] += e[l];
       step2[l] += s2[l];
+    }
+  }
+
+  // A frustum field at the lanes' positions: 16 lanes at a time when the field's cells have
+  // 32-bit indices, one voxel at a time otherwise.
+  static void gather(const FrustumFieldView& d, bool on, const float* x, const float* y,
+                     const float* z, int n, float* out) {
+    if (!on) return;
+    if (!gathersInLanes(d)) {
+      for (int l = 0; l < n; ++l) {
+        const glm::vec3 p(x[l], y[l], z[l]);
+        out[l] = d.inside(p) ? d.sample(p) : 0.f;
+      }
+    } else if (d.half()) {
+      sampleLanes<Half>(d, x, y, z, n, out);
+    } else {
+      sampleLanes<float>(d, x, y, z, n, out);
     }
   }
 

@@ -25,18 +25,16 @@
 #include <cstdint>
 #include <type_traits>
 
-#if defined(__AVX512F__)
-#include <immintrin.h>
-#endif
-
 #include "core/frustum_field.h"
 #include "core/half.h"
+#include "host/simd_gather.h"
 #include "kernels/ray_fast_math.h"
 #include "kernels/visibility_scan_fast.h"
 
 namespace visopt {
 
 constexpr int kPacketRays = kTileRays;
+static_assert(kPacketRays == kGatherLanes);
 
 // The packet's rays: a shared origin (the eye or the light, in index space) and one direction,
 // screen weight and solid angle per lane. Lanes past the frustum's edge are inactive.
@@ -88,9 +86,10 @@ struct Corners {
     const float hx = float(dims.x - 1), hy = float(dims.y - 1), hz = float(dims.z - 1);
     const int rowY = dims.x, rowZ = dims.x * dims.y;
     for (int l = 0; l < kPacketRays; ++l) {
-      const float x = std::min(std::max(px[l], 0.f), hx);
-      const float y = std::min(std::max(py[l], 0.f), hy);
-      const float z = std::min(std::max(pz[l], 0.f), hz);
+      // maxOf(NaN, 0) is 0: a lane whose ray is not finite keeps its corners in the grid.
+      const float x = minOf(maxOf(px[l], 0.f), hx);
+      const float y = minOf(maxOf(py[l], 0.f), hy);
+      const float z = minOf(maxOf(pz[l], 0.f), hz);
       const int i0 = int(x), j0 = int(y), k0 = int(z);
       fx[l] = x - float(i0);
       fy[l] = y - float(j0);
@@ -110,41 +109,10 @@ struct Corners {
     }
   }
 
-  // The field's values at the corners, per lane: with AVX-512 one 16-lane gather per corner
-  // (g++ does not turn the portable loop below into gathers for fp16, and splits it for fp32).
-  // fp16 gathers the aligned 32-bit word that holds each value and keeps its low or high half
-  // (little-endian); that word never passes the allocation's end, as fields are allocated in
-  // whole 64-byte lines (exec::allocate).
+  // The field's values at the corners, per lane (host/simd_gather.h).
   template <class Storage>
   void load(const FieldView& f, float v[8][kPacketRays]) const {
-#if defined(__AVX512F__)
-    static_assert(kPacketRays == 16);
-    // g++ 12's intrinsics initialise their unused pass-through operand from itself, which
-    // -Wmaybe-uninitialized reports at every call (GCC bug 105593, fixed in g++ 13).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-    for (int c = 0; c < 8; ++c) {
-      const __m512i i = _mm512_load_si512(index[c]);
-      if constexpr (std::is_same_v<Storage, Half>) {
-        const __m512i word = _mm512_i32gather_epi32(_mm512_srli_epi32(i, 1), f.data, 4);
-        const __m512i shift = _mm512_slli_epi32(_mm512_and_si512(i, _mm512_set1_epi32(1)), 4);
-        const __m256i bits = _mm512_cvtepi32_epi16(_mm512_srlv_epi32(word, shift));
-        _mm512_store_ps(v[c], _mm512_cvtph_ps(bits));
-      } else {
-        _mm512_store_ps(v[c], _mm512_i32gather_ps(i, f.data, 4));
-      }
-    }
-#pragma GCC diagnostic pop
-#else
-    const Storage* data = static_cast<const Storage*>(f.data);
-    for (int c = 0; c < 8; ++c)
-      for (int l = 0; l < kPacketRays; ++l) {
-        if constexpr (std::is_same_v<Storage, Half>)
-          v[c][l] = halfToFloat(data[index[c][l]]);
-        else
-          v[c][l] = data[index[c][l]];
-      }
-#endif
+    for (int c = 0; c < 8; ++c) gatherLanes<Storage>(f.data, index[c], v[c]);
   }
 
   // TrilinearCorners::interpolate per lane.
@@ -244,9 +212,9 @@ void frontToBackPacket(const VisibilityScan& scan, const RayPacket& rays, ScanSu
     if (skipFlags) {
       // ScanSkipGrid::at per lane: the brick indices in vector lanes, then the byte loads.
       for (int l = 0; l < L; ++l) {
-        const int bi = int(std::min(std::max(px[l], 0.f), skipHi.x)) >> kScanSkipShift;
-        const int bj = int(std::min(std::max(py[l], 0.f), skipHi.y)) >> kScanSkipShift;
-        const int bk = int(std::min(std::max(pz[l], 0.f), skipHi.z)) >> kScanSkipShift;
+        const int bi = int(minOf(maxOf(px[l], 0.f), skipHi.x)) >> kScanSkipShift;
+        const int bj = int(minOf(maxOf(py[l], 0.f), skipHi.y)) >> kScanSkipShift;
+        const int bk = int(minOf(maxOf(pz[l], 0.f), skipHi.z)) >> kScanSkipShift;
         brick[l] = in[l] ? (bk * skipBricks.y + bj) * skipBricks.x + bi : 0;
       }
       for (int l = 0; l < L; ++l) meets[l] = in[l] ? skipFlags[brick[l]] : 0;

@@ -20,6 +20,19 @@ namespace visopt {
 
 constexpr int kGatherLanes = 16;
 
+// gatherLanes without SIMD: what it computes, and what it runs on a CPU without AVX-512.
+template <class Storage>
+inline void gatherLanesPortable(const void* data, const int* index, float* out) {
+  static_assert(std::is_same_v<Storage, float> || std::is_same_v<Storage, Half>);
+  const Storage* values = static_cast<const Storage*>(data);
+  for (int l = 0; l < kGatherLanes; ++l) {
+    if constexpr (std::is_same_v<Storage, Half>)
+      out[l] = halfToFloat(values[index[l]]);
+    else
+      out[l] = values[index[l]];
+  }
+}
+
 // out[l] = data[index[l]] as float, l < 16; index and out 64-byte aligned.
 template <class Storage>
 inline void gatherLanes(const void* data, const int* index, float* out) {
@@ -41,13 +54,7 @@ inline void gatherLanes(const void* data, const int* index, float* out) {
   }
 #pragma GCC diagnostic pop
 #else
-  const Storage* values = static_cast<const Storage*>(data);
-  for (int l = 0; l < kGatherLanes; ++l) {
-    if constexpr (std::is_same_v<Storage, Half>)
-      out[l] = halfToFloat(values[index[l]]);
-    else
-      out[l] = values[index[l]];
-  }
+  gatherLanesPortable<Storage>(data, index, out);
 #endif
 }
 

@@ -12,8 +12,10 @@
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "host/extinction_step_rows.h"
+#include "host/importance_behind_rows.h"
 #include "host/visibility_scan_tiles.h"
 #include "kernels/extinction_step.h"
+#include "kernels/importance_behind.h"
 #include "kernels/visibility_scan_fast.h"
 #include "optimize/level_end.h"
 #include "optimize/level_set.h"
@@ -638,38 +640,26 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   // ghat (Eq. 19): half the max importance behind x along the view ray, half along the light
   // ray (the light grids exist whenever there are surfaces).
   auto t0 = Clock::now();
-  const GridMap map(L.grid);
-  FieldView ghat(*L.ghat);
-  const FrustumMap view(L.view), light(L.light);
-  const FrustumFieldView viewMax =
-      L.viewMax ? FrustumFieldView(*L.viewMax, L.view.dims) : FrustumFieldView();
-  const FrustumFieldView lightMax =
-      L.lightMax ? FrustumFieldView(*L.lightMax, L.light.dims) : FrustumFieldView();
-  // The lens and windowing masks weigh the light half too, by the screen position of x: under
-  // a lens of strength 0 a surface keeps its shape, not opening towards the light either.
-  const ScreenWeights weights = screenWeightsOf(in);
-  const BrickOrder order(map.dims);
-  if (!L.ghatFixed)
-    exec::parallelFor(
-        "grid updates: importance behind", order.launches(), [=] VISOPT_HD(int64_t n) {
-          int i, j, k;
-          if (!order.voxel(n, i, j, k)) return;
-          const size_t v =
-              (size_t(k) * size_t(map.dims.y) + size_t(j)) * size_t(map.dims.x) + size_t(i);
-          const glm::vec3 x = map.toWorld(glm::vec3(float(i), float(j), float(k)));
-          const float vm = gatherFrustum(view, viewMax, x);
-          float g = vm;
-          if (lightMax.valid()) {
-            float lm = gatherFrustum(light, lightMax, x);
-            if (weights.active()) {
-              const glm::vec3 y = view.toGrid(x);
-              if (y.z >= -0.5f && y.z <= float(view.dims.z) - 0.5f)
-                lm = fminf(lm * weights.atPoint(y.x, y.y, view.dims.x, view.dims.y), 1.f);
-            }
-            g = 0.5f * vm + 0.5f * lm;
-          }
-          ghat.store(v, fminf(fmaxf(g, 0.f), 1.f));
-        });
+  ImportanceBehind behind;
+  behind.volume = GridMap(L.grid);
+  behind.ghat = FieldView(*L.ghat);
+  behind.view = FrustumMap(L.view);
+  behind.light = FrustumMap(L.light);
+  if (L.viewMax) behind.viewMax = FrustumFieldView(*L.viewMax, L.view.dims);
+  if (L.lightMax) behind.lightMax = FrustumFieldView(*L.lightMax, L.light.dims);
+  behind.weights = screenWeightsOf(in);
+  if (!L.ghatFixed) {
+    if (activeBackend() == Backend::CPU) {
+      importanceBehindOnHost("grid updates: importance behind", behind);
+    } else {
+      const BrickOrder order(behind.volume.dims);
+      exec::parallelFor("grid updates: importance behind", order.launches(),
+                        [=] VISOPT_HD(int64_t n) {
+                          int i, j, k;
+                          if (order.voxel(n, i, j, k)) behind(i, j, k);
+                        });
+    }
+  }
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   // The bricks of each band that this ghat leaves as they are (narrow_band.h), once per ghat.
   for (size_t si = 0; si < L.phi.size(); ++si)

@@ -37,8 +37,8 @@ struct RowStep {
     alignas(64) float dv[kLanes] = {}, dl[kLanes] = {}, mbar[kLanes];
     const bool viewOn = grad.q != 0.f && grad.dView.valid();
     const bool lightOn = grad.r != 0.f && grad.dLight.valid();
-    gather(grad.dView, viewOn, vx, vy, vz, n, dv);
-    gather(grad.dLight, lightOn, lx, ly, lz, n, dl);
+    if (viewOn) sampleFrustumField(grad.dView, vx, vy, vz, n, dv);
+    if (lightOn) sampleFrustumField(grad.dLight, lx, ly, lz, n, dl);
     for (int l = 0; l < n; ++l) mbar[l] = grad.base.at(v0 + size_t(l));
     // The gradient (ExtinctionGradient::at; a term that is off has d = 0 and adds nothing) and
     // the optimiser step (kernels/optimizer_update.h), vectorised. The sums go to local lanes
@@ -60,23 +60,6 @@ struct RowStep {
     for (int l = 0; l < kLanes; ++l) {
       energy[l] += e[l];
       step2[l] += s2[l];
-    }
-  }
-
-  // A frustum field at the lanes' positions: 16 lanes at a time when the field's cells have
-  // 32-bit indices, one voxel at a time otherwise.
-  static void gather(const FrustumFieldView& d, bool on, const float* x, const float* y,
-                     const float* z, int n, float* out) {
-    if (!on) return;
-    if (!frustumGathersInLanes(d)) {
-      for (int l = 0; l < n; ++l) {
-        const glm::vec3 p(x[l], y[l], z[l]);
-        out[l] = d.inside(p) ? d.sample(p) : 0.f;
-      }
-    } else if (d.half()) {
-      sampleFrustumLanes<Half>(d, x, y, z, n, out);
-    } else {
-      sampleFrustumLanes<float>(d, x, y, z, n, out);
     }
   }
 

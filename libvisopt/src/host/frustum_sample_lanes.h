@@ -83,4 +83,22 @@ inline bool frustumGathersInLanes(const FrustumFieldView& d) {
   return d.storage.size() < (size_t(1) << 31);
 }
 
+// gatherFrustum's rules at kFrustumLanes frustum positions (lanes n and up: 0): 0 where the field
+// is absent or the position outside it. Fields past 32-bit indices are sampled lane by lane.
+inline void sampleFrustumField(const FrustumFieldView& d, const float* x, const float* y,
+                               const float* z, int n, float* out) {
+  if (!d.valid()) {
+    for (int l = 0; l < kFrustumLanes; ++l) out[l] = 0.f;
+  } else if (!frustumGathersInLanes(d)) {
+    for (int l = 0; l < kFrustumLanes; ++l) {
+      const glm::vec3 p(x[l], y[l], z[l]);
+      out[l] = l < n && d.inside(p) ? d.sample(p) : 0.f;
+    }
+  } else if (d.half()) {
+    sampleFrustumLanes<Half>(d, x, y, z, n, out);
+  } else {
+    sampleFrustumLanes<float>(d, x, y, z, n, out);
+  }
+}
+
 }  // namespace visopt

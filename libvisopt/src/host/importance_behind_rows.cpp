@@ -13,23 +13,6 @@ namespace {
 
 constexpr int kLanes = kFrustumLanes;
 
-// A frustum field at the lanes' frustum coordinates (0 where the field is absent).
-void sample(const FrustumFieldView& d, const float* x, const float* y, const float* z, int n,
-            float* out) {
-  if (!d.valid()) {
-    std::fill(out, out + kLanes, 0.f);
-  } else if (!frustumGathersInLanes(d)) {
-    for (int l = 0; l < n; ++l) {
-      const glm::vec3 p(x[l], y[l], z[l]);
-      out[l] = d.inside(p) ? d.sample(p) : 0.f;
-    }
-  } else if (d.half()) {
-    sampleFrustumLanes<Half>(d, x, y, z, n, out);
-  } else {
-    sampleFrustumLanes<float>(d, x, y, z, n, out);
-  }
-}
-
 void chunk(const ImportanceBehind& k, int i0, int j, int kz, int n) {
   alignas(64) float wx[kLanes] = {}, wy[kLanes] = {}, wz[kLanes] = {};
   alignas(64) float vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {};
@@ -46,8 +29,8 @@ void chunk(const ImportanceBehind& k, int i0, int j, int kz, int n) {
     }
   }
   alignas(64) float vm[kLanes], lm[kLanes];
-  sample(k.viewMax, vx, vy, vz, n, vm);
-  sample(k.lightMax, lx, ly, lz, n, lm);
+  sampleFrustumField(k.viewMax, vx, vy, vz, n, vm);
+  sampleFrustumField(k.lightMax, lx, ly, lz, n, lm);
   const glm::ivec3 dims = k.volume.dims;
   const size_t row = (size_t(kz) * size_t(dims.y) + size_t(j)) * size_t(dims.x) + size_t(i0);
   for (int l = 0; l < n; ++l)

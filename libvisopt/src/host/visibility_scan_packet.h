@@ -59,21 +59,11 @@ bool packetScanApplies(const VisibilityScan& scan) {
 
 namespace packet {
 
-// e^-x for x >= 0: rayExp2's range reduction and polynomial (kernels/ray_fast_math.h, relative
-// error below 3e-7), written without branches so that the lanes vectorise.
+// e^-x for x >= 0 (kernels/ray_fast_math.h, relative error below 3e-7): a polynomial the lanes
+// vectorise, where expf is a library call per lane (this unit builds with -fno-trapping-math, so
+// rayExp2's range clamps if-convert).
 inline float expNeg(float x) {
-  const float y = std::max(-1.44269504088896f * x, -126.f);
-  const int k = int(y + 127.5f) - 127;  // round(y); the shift makes the truncation a floor
-  const float r = (y - float(k)) * 0.693147180559945f;
-  float p = 1.f / 5040.f;
-  p = p * r + 1.f / 720.f;
-  p = p * r + 1.f / 120.f;
-  p = p * r + 1.f / 24.f;
-  p = p * r + 1.f / 6.f;
-  p = p * r + 0.5f;
-  p = p * r + 1.f;
-  p = p * r + 1.f;
-  return p * rayfast::bitsToFloat(uint32_t(k + 127) << 23);
+  return rayExp2(-1.44269504088896f * x);
 }
 
 // The eight corners of each lane's trilinear sample (as TrilinearCorners: clamped to the grid,

@@ -38,6 +38,9 @@ struct TransmittanceScan {
     const RayInterval box = intersectBox(o, d, glm::vec3(volume.dims - 1));
     float opticalDepth = 0.f;
     bool blocked = false;
+    // exp only when its argument moved: cells before, past and between the volume's matter keep
+    // T (most of a light frustum's cells; the same bits as evaluating it every cell).
+    float lastArgument = 0.f, lastT = 1.f;
     for (int k = 0; k < frustum.dims.z; ++k) {
       if (!surfaces.empty() && !blocked && !box.empty()) {
         const float s = frustum.depthOf(float(k));
@@ -53,7 +56,12 @@ struct TransmittanceScan {
         const float b = fminf(frustum.depthOf(float(k)) + 0.5f * frustum.ds, box.t1);
         if (b > a) tau = extinction(o + (0.5f * (a + b)) * d) * (b - a);
       }
-      out.store(out.index(i, j, k), expf(-(opticalDepth + (midpoint ? 0.5f * tau : 0.f))));
+      const float argument = opticalDepth + (midpoint ? 0.5f * tau : 0.f);
+      if (argument != lastArgument) {
+        lastArgument = argument;
+        lastT = expf(-argument);
+      }
+      out.store(out.index(i, j, k), lastT);
       opticalDepth += tau;
     }
   }

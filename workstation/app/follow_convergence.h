@@ -21,8 +21,7 @@ class FollowConvergence {
   bool add(const IterationStats& st, const ExtinctionSettings& s);
 
  private:
-  std::vector<IterationStats> history_;
-  double lastEnergy_ = 0.0;
+  std::vector<IterationStats> history_;  // since the last reset, oldest first
   int quiet_ = 0;
 };
 

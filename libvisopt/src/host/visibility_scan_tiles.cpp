@@ -65,9 +65,9 @@ ScanSums scanTile(const VisibilityScan& scan, int64_t tile, TileBuffer& buf) {
   ScanSums sums;
   RayPacket rays;
   rays.lanes = lanes;
+  rays.o = scanRayOf(scan, i0, j).o;  // the eye or the light, the same for every ray
   for (int lane = 0; lane < lanes; ++lane) {
     const ScanRay ray = scanRayOf(scan, i0 + lane, j);
-    rays.o = ray.o;
     rays.dx[lane] = ray.d.x;
     rays.dy[lane] = ray.d.y;
     rays.dz[lane] = ray.d.z;

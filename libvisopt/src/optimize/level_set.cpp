@@ -21,6 +21,8 @@
 #include "kernels/level_set_step.h"
 #include "kernels/redistance.h"
 #include "optimize/narrow_band.h"
+#include "sdf/fast_sweep.h"
+#include "sdf/gaussian_smoothing.h"
 #include "visopt/error.h"
 
 namespace visopt {
@@ -643,110 +645,6 @@ struct IsoGradientKernel {
   }
 };
 
-// Zhao's fast sweeping (Math. Comp. 74, 2005) for |grad d| = 1 from a fixed band: Gauss-Seidel
-// sweeps in the 8 diagonal orderings, each voxel taking the smaller of its value and the
-// first-order Godunov (upwind) solution from its face neighbours, with the grid's own spacing
-// per axis. Rounds of 8 sweeps repeat until a round changes nothing by more than `tolerance`
-// (world units; cavities and concave parts need a few). Host code: it runs once per base SDF.
-void fastSweep(std::vector<float>& d, const std::vector<uint8_t>& fixed, glm::ivec3 dims,
-               glm::vec3 spacing, float tolerance, int maxRounds) {
-  const int64_t nx = dims.x, ny = dims.y, nz = dims.z;
-  const double w[3] = {1.0 / (double(spacing.x) * spacing.x), 1.0 / (double(spacing.y) * spacing.y),
-                       1.0 / (double(spacing.z) * spacing.z)};
-  const double hs[3] = {spacing.x, spacing.y, spacing.z};
-  const float inf = std::numeric_limits<float>::infinity();
-  auto update = [&](int64_t i, int64_t j, int64_t k) -> float {
-    const int64_t v = i + nx * (j + ny * k);
-    const float c = d[size_t(v)];
-    std::pair<double, int> a[3];
-    const float ax = std::min(i > 0 ? d[size_t(v - 1)] : inf, i + 1 < nx ? d[size_t(v + 1)] : inf);
-    const float ay =
-        std::min(j > 0 ? d[size_t(v - nx)] : inf, j + 1 < ny ? d[size_t(v + nx)] : inf);
-    const float az =
-        std::min(k > 0 ? d[size_t(v - nx * ny)] : inf, k + 1 < nz ? d[size_t(v + nx * ny)] : inf);
-    a[0] = {ax, 0};
-    a[1] = {ay, 1};
-    a[2] = {az, 2};
-    std::sort(a, a + 3);
-    if (!(a[0].first < double(c))) return c;  // no smaller neighbour
-    // One term, then two, then three, while the solution exceeds the next neighbour.
-    double u = a[0].first + hs[a[0].second];
-    double sw = 0.0, swa = 0.0, swa2 = 0.0;
-    for (int m = 0; m < 3; ++m) {
-      if (m > 0 && !(u > a[m].first)) break;
-      const double wm = w[a[m].second];
-      sw += wm;
-      swa += wm * a[m].first;
-      swa2 += wm * a[m].first * a[m].first;
-      if (m == 0) continue;
-      const double disc = swa * swa - sw * (swa2 - 1.0);
-      if (disc < 0.0) break;  // cannot happen for sorted finite a; keep the previous u
-      u = (swa + std::sqrt(disc)) / sw;
-    }
-    return std::min(c, float(u));
-  };
-  for (int round = 0; round < maxRounds; ++round) {
-    float change = 0.f;
-    for (int dir = 0; dir < 8; ++dir) {
-      const bool fx = dir & 1, fy = dir & 2, fz = dir & 4;
-      for (int64_t kk = 0; kk < nz; ++kk) {
-        const int64_t k = fz ? nz - 1 - kk : kk;
-        for (int64_t jj = 0; jj < ny; ++jj) {
-          const int64_t j = fy ? ny - 1 - jj : jj;
-          for (int64_t ii = 0; ii < nx; ++ii) {
-            const int64_t i = fx ? nx - 1 - ii : ii;
-            const size_t v = size_t(i + nx * (j + ny * k));
-            if (fixed[v]) continue;
-            const float u = update(i, j, k);
-            if (u < d[v]) {
-              change = std::max(change, std::isinf(d[v]) ? inf : d[v] - u);
-              d[v] = u;
-            }
-          }
-        }
-      }
-    }
-    if (change <= tolerance) break;
-  }
-}
-
-// A separable Gaussian of standard deviation sigma (voxels of each axis) of `in`, in fp32; the
-// edge voxels repeat beyond the faces. Host code, once per base SDF.
-Field3D gaussianSmoothed(const Field3D& in, float sigma, MemoryLedger* ledger) {
-  const GridSpec& g = in.grid();
-  const int64_t n[3] = {g.dims.x, g.dims.y, g.dims.z};
-  const int64_t stride[3] = {1, n[0], n[0] * n[1]};
-  const int radius = std::max(1, int(std::ceil(3.f * sigma)));
-  std::vector<float> w(static_cast<size_t>(2 * radius + 1));
-  float total = 0.f;
-  for (int o = -radius; o <= radius; ++o)
-    total += w[size_t(o + radius)] = std::exp(-0.5f * float(o * o) / (sigma * sigma));
-  for (float& x : w) x /= total;
-  const FieldView src(in);
-  std::vector<float> a(in.size()), b(in.size());
-  for (size_t v = 0; v < a.size(); ++v) a[v] = src.load(v);
-  for (int axis = 0; axis < 3; ++axis) {
-    const int64_t len = n[axis], st = stride[axis];
-    if (len < 2) continue;
-    std::vector<float> line(static_cast<size_t>(len));
-    for (int64_t start = 0; start < int64_t(a.size()); ++start) {
-      if ((start / st) % len != 0) continue;  // one line per voxel on the axis's first plane
-      for (int64_t q = 0; q < len; ++q) line[size_t(q)] = a[size_t(start + q * st)];
-      for (int64_t q = 0; q < len; ++q) {
-        float acc = 0.f;
-        for (int o = -radius; o <= radius; ++o)
-          acc += w[size_t(o + radius)] * line[size_t(std::clamp<int64_t>(q + o, 0, len - 1))];
-        b[size_t(start + q * st)] = acc;
-      }
-    }
-    std::swap(a, b);
-  }
-  Field3D out("sdf-smoothed-scalar", g, Precision::FP32, ledger);
-  const FieldView dst(out);
-  for (size_t v = 0; v < a.size(); ++v) dst.store(v, a[v]);
-  return out;
-}
-
 }  // namespace
 
 Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
@@ -809,17 +707,21 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
     std::vector<uint8_t> negative(n);
     const FieldView start(phi), banded(scratch);
     const InterfaceCount isBand{start};
-    for (size_t v = 0; v < n; ++v) {
-      negative[v] = start.load(v) < 0.f;
-      fixed[v] = isBand(int64_t(v)) != 0;
-      dist[v] = fixed[v] ? std::fabs(banded.load(v)) : std::numeric_limits<float>::infinity();
-    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t v = r.begin(); v != r.end(); ++v) {
+        negative[v] = start.load(v) < 0.f;
+        fixed[v] = isBand(int64_t(v)) != 0;
+        dist[v] = fixed[v] ? std::fabs(banded.load(v)) : std::numeric_limits<float>::infinity();
+      }
+    });
     fastSweep(dist, fixed, g.dims, g.spacing, 1e-3f * g.minSpacing(), 8);
     const FieldView out(phi);
-    for (size_t v = 0; v < n; ++v) {
-      const float d = std::min(dist[v], far);
-      out.store(v, negative[v] ? -d : d);
-    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t v = r.begin(); v != r.end(); ++v) {
+        const float d = std::min(dist[v], far);
+        out.store(v, negative[v] ? -d : d);
+      }
+    });
   }
   // 64 polishing iterations bring the worst error on a sphere from 0.9 voxel (the sweep's
   // first order) to 0.26, as low as the full run's, and the band's from 0.13 to 0.03.

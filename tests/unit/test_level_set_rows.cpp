@@ -272,3 +272,103 @@ TEST(RedistanceRows, RowLoopMatchesThePerVoxelPath) {
         compareRedistanceRowsWithVoxels<Fp16Access, 2>(dims, initialise, withBase);
       }
 }
+
+namespace {
+
+// Spans of every length from 1 to 20 voxels at positions along a 40-voxel row, from the row's
+// first voxel to its last (the band path's runs of bricks, some shorter than a 16-lane chunk):
+// each voxel of a span gets the per-voxel path's value, nothing outside the span is written (a
+// chunk reaching past a short span must leave the band's halo alone), and the span's sums are
+// the per-voxel sums over its voxels.
+template <class A, class K>
+void compareShortSpansWithVoxels(
+    K k, glm::ivec3 dims,
+    std::vector<std::conditional_t<std::is_same_v<A, Fp16Access>, Half, float>>& scratch) {
+  using Store = std::conditional_t<std::is_same_v<A, Fp16Access>, Half, float>;
+  const size_t n = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
+  std::vector<Store> reference(n);
+  k.out = A{reference.data()};
+  std::vector<ChangeSums> perVoxel(n);
+  for (int64_t v = 0; v < int64_t(n); ++v) perVoxel[size_t(v)] = k.voxel(v);
+  const float ulps = std::is_same_v<Store, Half> ? 1e-3f : 1e-6f;
+  const float sentinel = 2048.f;  // exact in fp16, far from any value the kernels write
+  int spans = 0;
+  for (int64_t r = 0; r < int64_t(dims.y) * dims.z; r += 3)
+    for (int x0 : {0, 1, 2, 3, 5, 9, 16, 21, 24, 30, 37, 39})
+      for (int len = 1; len <= 20 && x0 + len <= dims.x; ++len) {
+        const int x1 = x0 + len;
+        const size_t first = size_t(r) * size_t(dims.x);
+        for (int x = 0; x < dims.x; ++x) scratch[first + size_t(x)] = storeAs<Store>(sentinel);
+        k.out = A{scratch.data()};
+        const ChangeSums got = k.span(r, x0, x1);
+        ChangeSums want;
+        for (int x = x0; x < x1; ++x) want = want + perVoxel[first + size_t(x)];
+        for (int x = 0; x < dims.x; ++x) {
+          const float a = loadAs(scratch[first + size_t(x)]);
+          if (x < x0 || x >= x1) {
+            ASSERT_EQ(a, sentinel)
+                << "row " << r << " span [" << x0 << ", " << x1 << ") wrote voxel " << x;
+          } else {
+            const float b = loadAs(reference[first + size_t(x)]);
+            ASSERT_NEAR(a, b, ulps * std::max(1.f, std::fabs(b)))
+                << "row " << r << " span [" << x0 << ", " << x1 << ") voxel " << x;
+          }
+        }
+        const double rel = std::is_same_v<Store, Half> ? 1e-3 : 1e-5;
+        ASSERT_NEAR(got.maxAbs, want.maxAbs, rel * std::max(1.f, want.maxAbs));
+        ASSERT_NEAR(got.sumSquared, want.sumSquared, rel * std::max(1.0, want.sumSquared));
+        ASSERT_NEAR(got.nearSumSquared, want.nearSumSquared,
+                    rel * std::max(1.0, want.nearSumSquared));
+        ASSERT_EQ(got.nearCount, want.nearCount);
+        ASSERT_NEAR(got.insideRiseMax, want.insideRiseMax, rel * std::max(1.f, want.insideRiseMax));
+        ++spans;
+      }
+  EXPECT_GT(spans, 500);
+}
+
+template <class A>
+void shortSpans() {
+  using Store = std::conditional_t<std::is_same_v<A, Fp16Access>, Half, float>;
+  const glm::ivec3 dims(40, 7, 6);
+  const size_t n = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> noise(-0.4f, 0.4f), unit(0.f, 1.f);
+  std::vector<Store> phi(n), phi0(n), ghat(n), scratch(n);
+  const glm::vec3 centre(19.6f, 3.2f, 2.9f);
+  for (size_t v = 0; v < n; ++v) {
+    const glm::vec3 x(float(v % 40), float((v / 40) % 7), float(v / 280));
+    const float d = glm::length(x - centre) - 2.6f;
+    phi0[v] = storeAs<Store>(d);
+    phi[v] = storeAs<Store>((v % 2) ? d : d * (1.3f + noise(rng)));
+    ghat[v] = storeAs<Store>(unit(rng));
+  }
+  RedistanceKernel<A, 2> redistance;
+  redistance.in = A{phi.data()};
+  redistance.dims = dims;
+  redistance.spacing = glm::vec3(1.f, 1.3f, 0.7f);
+  redistance.dxMin = 0.7f;
+  redistance.dtau = 0.3f * redistance.dxMin;
+  redistance.initialise = true;
+  redistance.base = A{phi0.data()};
+  redistance.keepWithin = 0.05f * redistance.dxMin;
+  redistance.nearBand = 2.f * redistance.dxMin;
+  compareShortSpansWithVoxels<A>(redistance, dims, scratch);
+
+  LevelSetStepKernel<A, 2> step;
+  step.phi = A{phi.data()};
+  step.phi0 = A{phi0.data()};
+  step.ghat = A{ghat.data()};
+  step.dims = dims;
+  step.spacing = glm::vec3(1.f, 1.3f, 0.7f);
+  step.dt = 0.05f;
+  step.lambda = 0.4f;
+  step.kappaMax = 1.f / 0.7f;
+  compareShortSpansWithVoxels<A>(step, dims, scratch);
+}
+
+}  // namespace
+
+TEST(RedistanceRows, ShortSpansMatchThePerVoxelPathAndWriteNothingOutside) {
+  shortSpans<Fp32Access>();
+  shortSpans<Fp16Access>();
+}

@@ -9,6 +9,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include "exec/parallel.h"
+
 namespace visopt {
 
 namespace {
@@ -123,6 +125,7 @@ void fastSweepSerial(std::vector<float>& d, const std::vector<uint8_t>& fixed, g
 
 void fastSweep(std::vector<float>& d, const std::vector<uint8_t>& fixed, glm::ivec3 dims,
                glm::vec3 spacing, float tolerance, int maxRounds) {
+  const exec::LaunchTimer timer("sdf: fast sweep", double(d.size()));
   const Sweeper s = sweeperFor(d, fixed, dims, spacing);
   const int64_t diagonals = s.ny + s.nz - 1;
   // Every voxel is looked at in the first sweep, then only those next to a change.

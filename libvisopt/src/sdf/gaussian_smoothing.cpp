@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/field_view.h"
+#include "exec/parallel.h"
 
 namespace visopt {
 
@@ -16,6 +17,7 @@ namespace visopt {
 // values and summed offset by offset over the whole row (the inner loop runs along x and
 // vectorises); along y and z whole x rows are summed the same way.
 Field3D gaussianSmoothed(const Field3D& in, float sigma, MemoryLedger* ledger) {
+  const exec::LaunchTimer timer("sdf: smoothing", double(in.size()));
   const GridSpec& g = in.grid();
   const int64_t nx = g.dims.x, ny = g.dims.y, nz = g.dims.z;
   const int r = std::max(1, int(std::ceil(3.f * sigma)));

@@ -33,63 +33,90 @@ struct Sweeper {
     const float ay = std::min(j > 0 ? d[v - nx] : inf, j + 1 < ny ? d[v + nx] : inf);
     const float az = std::min(k > 0 ? d[v - nx * ny] : inf, k + 1 < nz ? d[v + nx * ny] : inf);
     if (!(std::min(ax, std::min(ay, az)) < c)) return c;  // no smaller neighbour
-    std::pair<double, int> a[3] = {{ax, 0}, {ay, 1}, {az, 2}};
-    if (a[1] < a[0]) std::swap(a[0], a[1]);
-    if (a[2] < a[1]) std::swap(a[1], a[2]);
-    if (a[1] < a[0]) std::swap(a[0], a[1]);
-    // One term, then two, then three, while the solution exceeds the next neighbour.
-    double u = a[0].first + hs[a[0].second];
-    double sw = 0.0, swa = 0.0, swa2 = 0.0;
-    for (int m = 0; m < 3; ++m) {
-      if (m > 0 && !(u > a[m].first)) break;
-      const double wm = w[a[m].second];
-      sw += wm;
-      swa += wm * a[m].first;
-      swa2 += wm * a[m].first * a[m].first;
-      if (m == 0) continue;
-      const double disc = swa * swa - sw * (swa2 - 1.0);
-      if (disc < 0.0) break;  // cannot happen for sorted finite a; keep the previous u
-      u = (swa + std::sqrt(disc)) / sw;
-    }
+    // The upwind values sorted with their axes, as a sort of (value, axis) pairs orders them;
+    // compare-and-select steps rather than branches, which the data make unpredictable.
+    double a0 = ax, a1 = ay, a2 = az;
+    int x0 = 0, x1 = 1, x2 = 2;
+    auto order = [](double& va, int& ia, double& vb, int& ib) {
+      const bool swap = vb < va || (vb == va && ib < ia);
+      const double lo = swap ? vb : va, hi = swap ? va : vb;
+      const int il = swap ? ib : ia, ih = swap ? ia : ib;
+      va = lo;
+      vb = hi;
+      ia = il;
+      ib = ih;
+    };
+    order(a0, x0, a1, x1);
+    order(a1, x1, a2, x2);
+    order(a0, x0, a1, x1);
+    // One term, then two, then three, while the solution exceeds the next neighbour: all three
+    // computed, then the one that applies selected (a square root of a negative discriminant,
+    // which only an unselected solution can have, is taken of 0 instead).
+    const double w0 = w[x0], w1 = w[x1], w2 = w[x2];
+    const double u1 = a0 + hs[x0];
+    const double sw1 = w0, swa1 = w0 * a0, swa21 = w0 * a0 * a0;
+    const double sw2 = sw1 + w1, swa2 = swa1 + w1 * a1, swa22 = swa21 + w1 * a1 * a1;
+    const double disc2 = swa2 * swa2 - sw2 * (swa22 - 1.0);
+    const double u2 = (swa2 + std::sqrt(std::max(disc2, 0.0))) / sw2;
+    const double sw3 = sw2 + w2, swa3 = swa2 + w2 * a2, swa23 = swa22 + w2 * a2 * a2;
+    const double disc3 = swa3 * swa3 - sw3 * (swa23 - 1.0);
+    const double u3 = (swa3 + std::sqrt(std::max(disc3, 0.0))) / sw3;
+    const bool two = u1 > a1 && !(disc2 < 0.0), three = two && u2 > a2 && !(disc3 < 0.0);
+    const double u = three ? u3 : (two ? u2 : u1);
     return std::min(c, float(u));
   }
 
-  // One x row of a sweep in direction fx, voxels flagged in `todo` only (clearing their flags and
-  // setting their face neighbours' when a voxel decreases), or every voxel without `todo`;
-  // returns the largest decrease. A voxel none of whose neighbours changed since it was last
-  // updated would keep its value (update() is a function of the neighbours and the value, which
-  // is already no larger than that function's result), so skipping it changes nothing. Rows on
-  // one anti-diagonal share no face, but two of them may flag the same voxel of a row on the
-  // next or the previous one (both with 1): the flags of other rows are set atomically.
-  float row(int64_t j, int64_t k, bool fx, uint8_t* todo = nullptr) const {
+  // One voxel of a sweep, looked at only when flagged in `todo` (clearing its flag and setting
+  // its face neighbours' when it decreases), or always without `todo`; returns its decrease. A
+  // voxel none of whose neighbours changed since it was last updated would keep its value
+  // (update() is a function of the neighbours and the value, which is already no larger than
+  // that function's result), so skipping it changes nothing. Rows on one anti-diagonal share no
+  // face, but two of them may flag the same voxel of a row on the next or the previous one
+  // (both with 1): the flags of other rows are set atomically.
+  float voxel(int64_t i, int64_t j, int64_t k, uint8_t* todo) const {
     constexpr float inf = std::numeric_limits<float>::infinity();
-    float change = 0.f;
-    const int64_t plane = nx * ny;
-    auto flag = [&](int64_t v) {
-      std::atomic_ref<uint8_t>(todo[v]).store(1, std::memory_order_relaxed);
-    };
-    for (int64_t ii = 0; ii < nx; ++ii) {
-      const int64_t i = fx ? nx - 1 - ii : ii;
-      const int64_t v = i + nx * (j + ny * k);
-      if (todo) {
-        if (!todo[v]) continue;
-        todo[v] = 0;
-      }
-      if (fixed[v]) continue;
-      const float u = update(i, j, k);
-      if (u < d[v]) {
-        change = std::max(change, std::isinf(d[v]) ? inf : d[v] - u);
-        d[v] = u;
-        if (todo) {
-          if (i > 0) todo[v - 1] = 1;
-          if (i + 1 < nx) todo[v + 1] = 1;
-          if (j > 0) flag(v - nx);
-          if (j + 1 < ny) flag(v + nx);
-          if (k > 0) flag(v - plane);
-          if (k + 1 < nz) flag(v + plane);
-        }
-      }
+    const int64_t v = i + nx * (j + ny * k);
+    if (todo) {
+      if (!todo[v]) return 0.f;
+      todo[v] = 0;
     }
+    if (fixed[v]) return 0.f;
+    const float u = update(i, j, k);
+    if (!(u < d[v])) return 0.f;
+    const float change = std::isinf(d[v]) ? inf : d[v] - u;
+    d[v] = u;
+    if (todo) {
+      auto flag = [&](int64_t at) {
+        std::atomic_ref<uint8_t>(todo[at]).store(1, std::memory_order_relaxed);
+      };
+      if (i > 0) todo[v - 1] = 1;
+      if (i + 1 < nx) todo[v + 1] = 1;
+      if (j > 0) flag(v - nx);
+      if (j + 1 < ny) flag(v + nx);
+      if (k > 0) flag(v - nx * ny);
+      if (k + 1 < nz) flag(v + nx * ny);
+    }
+    return change;
+  }
+
+  // Rows (j[r], k[r]), r < count <= kRowGroup, of one anti-diagonal, in direction fx; returns
+  // the largest decrease. Along a row each voxel waits for the one before it (its new value is
+  // the next one's neighbour), a chain of loads, a square root and a division; the rows'
+  // voxels are taken in turn, so that the processor overlaps their independent chains. Each
+  // row still sees its voxels in the serial order.
+  static constexpr int kRowGroup = 4;
+  float rows(const int64_t* j, const int64_t* k, int count, bool fx, uint8_t* todo) const {
+    float change = 0.f;
+    if (count == kRowGroup) {
+      for (int64_t ii = 0; ii < nx; ++ii) {
+        const int64_t i = fx ? nx - 1 - ii : ii;
+        for (int r = 0; r < kRowGroup; ++r) change = std::max(change, voxel(i, j[r], k[r], todo));
+      }
+      return change;
+    }
+    for (int r = 0; r < count; ++r)
+      for (int64_t ii = 0; ii < nx; ++ii)
+        change = std::max(change, voxel(fx ? nx - 1 - ii : ii, j[r], k[r], todo));
     return change;
   }
 };
@@ -115,8 +142,10 @@ void fastSweepSerial(std::vector<float>& d, const std::vector<uint8_t>& fixed, g
       const bool fx = dir & 1, fy = dir & 2, fz = dir & 4;
       for (int64_t kk = 0; kk < s.nz; ++kk) {
         const int64_t k = fz ? s.nz - 1 - kk : kk;
-        for (int64_t jj = 0; jj < s.ny; ++jj)
-          change = std::max(change, s.row(fy ? s.ny - 1 - jj : jj, k, fx));
+        for (int64_t jj = 0; jj < s.ny; ++jj) {
+          const int64_t j = fy ? s.ny - 1 - jj : jj;
+          change = std::max(change, s.rows(&j, &k, 1, fx, nullptr));
+        }
       }
     }
     if (change <= tolerance) break;
@@ -140,10 +169,14 @@ void fastSweep(std::vector<float>& d, const std::vector<uint8_t>& fixed, glm::iv
         const int64_t kkFirst = std::max<int64_t>(0, diag - (s.ny - 1));
         const int64_t kkEnd = std::min<int64_t>(s.nz, diag + 1);
         auto rows = [&](const tbb::blocked_range<int64_t>& r, float most) {
-          for (int64_t kk = r.begin(); kk != r.end(); ++kk) {
-            const int64_t jj = diag - kk;
-            most =
-                std::max(most, s.row(fy ? s.ny - 1 - jj : jj, fz ? s.nz - 1 - kk : kk, fx, todo));
+          for (int64_t kk = r.begin(); kk < r.end(); kk += Sweeper::kRowGroup) {
+            int64_t j[Sweeper::kRowGroup], k[Sweeper::kRowGroup];
+            const int count = int(std::min<int64_t>(Sweeper::kRowGroup, r.end() - kk));
+            for (int g = 0; g < count; ++g) {
+              j[g] = fy ? s.ny - 1 - (diag - kk - g) : diag - kk - g;
+              k[g] = fz ? s.nz - 1 - (kk + g) : kk + g;
+            }
+            most = std::max(most, s.rows(j, k, count, fx, todo));
           }
           return most;
         };

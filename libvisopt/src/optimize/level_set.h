@@ -73,9 +73,11 @@ inline constexpr float kIsoPresmoothSigma = 0.85f;
 
 // phi(x, 0) = +-(s~(x) - iso) / |grad s~| (inside negative: with insideHigh, values above the
 // isovalue are inside), |grad s~| the mean central-difference gradient magnitude over the voxels
-// next to the isosurface, then redistanced until converged (at least enough iterations for
-// the front to cross the grid's diagonal). `isovalue` is in the volume's data units. A volume
-// that never crosses the isovalue gives the scaled difference, all of one sign.
+// next to the isosurface; then the voxels next to the isosurface set to their subcell distance,
+// the distance swept from them to the whole grid (sdf/fast_sweep.h, first order) and polished
+// by redistancing until the voxels within 3 of the surface settle (level_set.cpp says why).
+// `isovalue` is in the volume's data units. A volume that never crosses the isovalue gives the
+// scaled difference, all of one sign.
 //
 // s~ is s smoothed by a separable Gaussian of standard deviation `presmoothSigma` voxels along
 // each axis (in that axis's own voxels; edge voxels repeat at the faces; <= 0: no smoothing).

@@ -186,6 +186,29 @@ TEST(LevelSetRows, RowLoopMatchesThePerVoxelPath) {
 
 namespace {
 
+// A redistancing kernel on `in` (anisotropic spacing 1 x 1.3 x 0.7, the ENO2 pseudo-time step),
+// holding voxels near `base` when one is given, counting the voxels within two of the smallest
+// spacing as near the surface.
+template <class A, int Order, class Store>
+RedistanceKernel<A, Order> redistanceKernelOn(Store* in, Store* base, glm::ivec3 dims,
+                                              bool initialise) {
+  RedistanceKernel<A, Order> k;
+  k.in = A{in};
+  k.dims = dims;
+  k.spacing = glm::vec3(1.f, 1.3f, 0.7f);
+  k.dxMin = 0.7f;
+  k.dtau = 0.3f * k.dxMin;
+  k.initialise = initialise;
+  if (base) {
+    k.base = A{base};
+    k.keepWithin = 0.05f * k.dxMin;
+  } else {
+    k.withoutBase();
+  }
+  k.nearBand = 2.f * k.dxMin;
+  return k;
+}
+
 // Redistancing (kernels/redistance.h) through sweepStepRow, whole rows and spans of rows (the
 // band path), against sweepVoxel: the first pass (subcell initialisation) and a later one, with
 // and without a base SDF whose nearby voxels are held.
@@ -208,20 +231,8 @@ void compareRedistanceRowsWithVoxels(glm::ivec3 dims, bool initialise, bool with
         // Half the voxels keep their base value (held when withBase), the rest are distorted.
         in[v] = store((v % 2) ? d : d * (1.3f + noise(rng)));
       }
-  RedistanceKernel<A, Order> k;
-  k.in = A{in.data()};
-  k.dims = dims;
-  k.spacing = glm::vec3(1.f, 1.3f, 0.7f);
-  k.dxMin = 0.7f;
-  k.dtau = 0.3f * k.dxMin;
-  k.initialise = initialise;
-  if (withBase) {
-    k.base = A{base.data()};
-    k.keepWithin = 0.05f * k.dxMin;
-  } else {
-    k.withoutBase();
-  }
-  k.nearBand = 2.f * k.dxMin;
+  RedistanceKernel<A, Order> k =
+      redistanceKernelOn<A, Order>(in.data(), withBase ? base.data() : nullptr, dims, initialise);
   k.out = A{outVoxels.data()};
   ChangeSums voxels;
   for (int64_t v = 0; v < int64_t(n); ++v) voxels = voxels + k.voxel(v);
@@ -342,17 +353,8 @@ void shortSpans() {
     phi[v] = storeAs<Store>((v % 2) ? d : d * (1.3f + noise(rng)));
     ghat[v] = storeAs<Store>(unit(rng));
   }
-  RedistanceKernel<A, 2> redistance;
-  redistance.in = A{phi.data()};
-  redistance.dims = dims;
-  redistance.spacing = glm::vec3(1.f, 1.3f, 0.7f);
-  redistance.dxMin = 0.7f;
-  redistance.dtau = 0.3f * redistance.dxMin;
-  redistance.initialise = true;
-  redistance.base = A{phi0.data()};
-  redistance.keepWithin = 0.05f * redistance.dxMin;
-  redistance.nearBand = 2.f * redistance.dxMin;
-  compareShortSpansWithVoxels<A>(redistance, dims, scratch);
+  compareShortSpansWithVoxels<A>(redistanceKernelOn<A, 2>(phi.data(), phi0.data(), dims, true),
+                                 dims, scratch);
 
   LevelSetStepKernel<A, 2> step;
   step.phi = A{phi.data()};

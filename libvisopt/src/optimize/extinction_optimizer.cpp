@@ -314,10 +314,6 @@ ScreenWeights screenWeightsOf(const OptimizationInputs& in) {
   return weights;
 }
 
-// The joint loop's redistancing stops once the band within this many voxels of the surfaces has
-// settled (level_set.h: redistance).
-constexpr float kRedistanceStopBand = 3.f;
-
 // Substeps of the level-set step per iteration on `level` (LevelSetSettings::reach).
 int levelSetSubsteps(const OptimizationInputs& in, const ExtinctionSettings& s,
                      const GridSpec& level, int cap) {
@@ -723,7 +719,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
       for (size_t si = 0; si < L.phi.size(); ++si) {
         const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];
         RedistanceStats rs = redistance(L.phi[si], in.levelSet, *L.scratch, &phi0,
-                                        kRedistanceStopBand, &L.bands[si]);
+                                        kRedistanceStopBandVoxels, &L.bands[si]);
         st.redistanceIterations = std::max(st.redistanceIterations, rs.iterations);
         ++st.redistanceCalls;
         st.redistancePasses += rs.iterations;

@@ -613,9 +613,6 @@ RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scr
 
 // ---- an SDF from an isovalue ----------------------------------------------------------------
 
-// sdfFromIsovalue's polish stops once the voxels within this many voxels of the surface settle.
-constexpr float kIsoPolishStopBandVoxels = 3.f;
-
 namespace {
 
 struct IsoGradient {
@@ -695,7 +692,7 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
   //  3. up to 64 redistancing iterations from there bring the field near the interface to the
   //     second-order fixed point the long run reached; the band keeps its subcell values
   //     throughout (no re-initialisation). They stop once the voxels within
-  //     kIsoPolishStopBandVoxels of the surface change by less than 1e-6 voxel^2 (mean square),
+  //     kRedistanceStopBandVoxels of the surface change by less than 1e-6 voxel^2 (mean square),
   //     as the joint loop's redistancing measures its own: that band is where the level-set step
   //     and the narrow band start from. Farther out the iterations only relax the sweep's
   //     first-order values towards the second-order scheme's, which nothing reads as more than
@@ -739,7 +736,7 @@ Field3D sdfFromIsovalue(const Volume& volume, double isovalue, bool insideHigh,
   r.redistanceTolerance = std::min(s.redistanceTolerance, 1e-6f);
   pingPong(
       phi, scratch, r.redistanceIterations, nullptr, [&](const Field3D& from, Field3D& to, int) {
-        return redistancePass(from, to, false, r.spatialOrder, nullptr, kIsoPolishStopBandVoxels) <
+        return redistancePass(from, to, false, r.spatialOrder, nullptr, kRedistanceStopBandVoxels) <
                double(r.redistanceTolerance);
       });
   return phi;

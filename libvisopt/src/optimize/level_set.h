@@ -48,6 +48,9 @@ bool hasInterface(const Field3D& phi);
 // loop needs the distance: over the whole box, regions far from every surface that are still
 // converging (a region a surface left) hold every call to its iteration cap.
 inline constexpr float kRedistanceKeepsBaseWithin = 0.05f;
+// The stopBand the joint loop's redistancing and sdfFromIsovalue's polish measure settling over:
+// the voxels within 3 of the surface, where the level-set step needs a distance.
+inline constexpr float kRedistanceStopBandVoxels = 3.f;
 // `band` as for levelSetStep (one built there with phi0 serves a call without `base`).
 RedistanceStats redistance(Field3D& phi, const LevelSetSettings& s, Field3D& scratch,
                            const Field3D* base = nullptr, float stopBand = 0.f,

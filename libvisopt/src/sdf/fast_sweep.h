@@ -20,7 +20,7 @@ namespace visopt {
 // touch each other: a row reads its face-neighbour rows (j +- 1, k) and (j, k +- 1), which lie
 // on the anti-diagonals before and after. So the anti-diagonals run one after the other and the
 // rows on each in parallel, and every voxel sees exactly the neighbour values the serial sweep
-// gives it: the result equals fastSweepSerial's bit for bit (tests/unit/test_fast_sweep.cpp).
+// gives it: the result equals fastSweepSerial's bit for bit (tests/unit/test_sdf_building.cpp).
 void fastSweep(std::vector<float>& d, const std::vector<uint8_t>& fixed, glm::ivec3 dims,
                glm::vec3 spacing, float tolerance, int maxRounds);
 

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "core/field_view.h"
@@ -37,19 +38,22 @@ Field3D gaussianSmoothed(const Field3D& in, float sigma, MemoryLedger* ledger) {
 
   // Along x: a padded copy of the row, then the taps.
   if (nx > 1) {
-    tbb::parallel_for(int64_t(0), rows, [&](int64_t row) {
-      std::vector<float> padded(size_t(nx + 2 * r));
-      const float* line = &a[size_t(row * nx)];
-      for (int64_t q = 0; q < nx + 2 * r; ++q)
-        padded[size_t(q)] = line[std::clamp<int64_t>(q - r, 0, nx - 1)];
-      float* acc = &b[size_t(row * nx)];
-      std::fill(acc, acc + nx, 0.f);
-      for (int o = 0; o <= 2 * r; ++o) {
-        const float wo = w[size_t(o)];
-        const float* p = padded.data() + o;
-        for (int64_t q = 0; q < nx; ++q) acc[q] += wo * p[q];
-      }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<int64_t>(0, rows), [&](const tbb::blocked_range<int64_t>& range) {
+          std::vector<float> padded(size_t(nx + 2 * r));  // one per task, reused row after row
+          for (int64_t row = range.begin(); row != range.end(); ++row) {
+            const float* line = &a[size_t(row * nx)];
+            for (int64_t q = 0; q < nx + 2 * r; ++q)
+              padded[size_t(q)] = line[std::clamp<int64_t>(q - r, 0, nx - 1)];
+            float* acc = &b[size_t(row * nx)];
+            std::fill(acc, acc + nx, 0.f);
+            for (int o = 0; o <= 2 * r; ++o) {
+              const float wo = w[size_t(o)];
+              const float* p = padded.data() + o;
+              for (int64_t q = 0; q < nx; ++q) acc[q] += wo * p[q];
+            }
+          }
+        });
     std::swap(a, b);
   }
   // Along y and z: whole rows, the neighbour row at each offset clamped to the grid.

@@ -138,47 +138,81 @@ ScalarData readPayload(const std::string& path, uint64_t offset, ScalarType type
   return makeScalarData(std::move(buffer), type, count);
 }
 
+namespace {
+
+// Inflates a zlib or gzip stream from `file` into `out` (up to `want` bytes; more output goes to
+// a scratch buffer and is only counted), to the stream's end: the gzip trailer's CRC-32 and
+// length, and zlib's Adler-32, are checked there, so a corrupt stream or a missing tail is
+// refused rather than taken as good. Returns the total bytes the stream inflates to.
+uint64_t inflateStream(const std::string& path, std::FILE* file, unsigned char* out, size_t want) {
+  z_stream zs{};
+  if (inflateInit2(&zs, 15 + 32) != Z_OK)  // 15 + 32: accept zlib or gzip headers
+    throwBadInput(path, "cannot initialise zlib");
+  std::vector<unsigned char> in(1 << 16), scratch(1 << 16);
+  uint64_t produced = 0;
+  int rc = Z_OK;
+  bool eof = false;
+  while (rc != Z_STREAM_END) {
+    if (zs.avail_in == 0 && !eof) {
+      const size_t got = std::fread(in.data(), 1, in.size(), file);
+      eof = got == 0;
+      zs.next_in = in.data();
+      zs.avail_in = static_cast<uInt>(got);
+    }
+    if (zs.avail_in == 0 && eof) break;
+    const bool intoOut = produced < want;
+    const size_t chunk =
+        intoOut ? std::min<size_t>(want - size_t(produced), size_t(1) << 30) : scratch.size();
+    zs.next_out = intoOut ? out + produced : scratch.data();
+    zs.avail_out = static_cast<uInt>(chunk);
+    rc = inflate(&zs, Z_NO_FLUSH);
+    produced += chunk - zs.avail_out;
+    if (rc == Z_NEED_DICT || rc == Z_DATA_ERROR || rc == Z_MEM_ERROR) {
+      const std::string message = zs.msg ? zs.msg : "data error";
+      inflateEnd(&zs);
+      throwBadInput(path, "corrupt compressed data (zlib: " + message + ")");
+    }
+    if (rc == Z_BUF_ERROR && zs.avail_in == 0 && eof) break;
+  }
+  inflateEnd(&zs);
+  if (rc != Z_STREAM_END)
+    throwBadInput(path, "truncated: the compressed data ends before its stream does (" +
+                            sizeText(produced) + " inflated)");
+  return produced;
+}
+
+}  // namespace
+
 ScalarData readCompressedPayload(const std::string& path, uint64_t offset, ScalarType type,
                                  size_t count, bool bigEndian) {
   const uint64_t fileSize = checkedFileSize(path);
   if (offset >= fileSize) throwBadInput(path, "truncated: no compressed data after the header");
   const size_t elementSize = scalarTypeSize(type);
   const size_t need = count * elementSize;
+  // Deflate inflates at most ~1032 to 1: a header that promises more than the compressed bytes
+  // can hold is refused before its buffer is allocated.
+  const uint64_t compressed = fileSize - offset;
+  if (need / kMaxDeflateRatio > compressed)
+    throwBadInput(path, "truncated: header describes " + sizeText(need) + ", " +
+                            sizeText(compressed) + " of compressed data inflate to at most " +
+                            sizeText(compressed * kMaxDeflateRatio));
   auto buffer = std::make_shared_for_overwrite<unsigned char[]>(std::max<size_t>(need, 1));
-
   FilePtr file = openAt(path, offset);
-  z_stream zs{};
-  if (inflateInit2(&zs, 15 + 32) != Z_OK)  // 15 + 32: accept zlib or gzip headers
-    throwBadInput(path, "cannot initialise zlib");
-  std::vector<unsigned char> in(1 << 16);
-  size_t produced = 0;
-  int rc = Z_OK;
-  bool eof = false;
-  while (produced < need && rc != Z_STREAM_END) {
-    if (zs.avail_in == 0 && !eof) {
-      size_t got = std::fread(in.data(), 1, in.size(), file.get());
-      if (got == 0) eof = true;
-      zs.next_in = in.data();
-      zs.avail_in = static_cast<uInt>(got);
-    }
-    if (zs.avail_in == 0 && eof) break;
-    size_t chunk = std::min<size_t>(need - produced, size_t(1) << 30);
-    zs.next_out = buffer.get() + produced;
-    zs.avail_out = static_cast<uInt>(chunk);
-    rc = inflate(&zs, Z_NO_FLUSH);
-    produced += chunk - zs.avail_out;
-    if (rc == Z_NEED_DICT || rc == Z_DATA_ERROR || rc == Z_MEM_ERROR) {
-      inflateEnd(&zs);
-      throwBadInput(path, "corrupt compressed data (zlib: " +
-                              std::string(zs.msg ? zs.msg : "data error") + ")");
-    }
-  }
-  inflateEnd(&zs);
+  const uint64_t produced = inflateStream(path, file.get(), buffer.get(), need);
   if (produced < need)
     throwBadInput(path, "truncated: compressed data inflates to " + sizeText(produced) +
                             ", header describes " + sizeText(need));
+  if (produced > need)
+    throwBadInput(path, "compressed data inflates to " + sizeText(produced) + ", more than the " +
+                            sizeText(need) + " the header describes (wrong dimensions or type?)");
   if (bigEndian != hostIsBigEndian()) swapBytesInPlace(buffer.get(), count, elementSize);
   return makeScalarData(std::move(buffer), type, count);
+}
+
+uint64_t inflatedSize(const std::string& path) {
+  checkedFileSize(path);
+  FilePtr file = openAt(path, 0);
+  return inflateStream(path, file.get(), nullptr, 0);
 }
 
 void checkOutputTarget(const std::string& path) {

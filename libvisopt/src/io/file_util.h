@@ -34,9 +34,15 @@ inline constexpr uint64_t kMaxTextInputBytes = uint64_t(64) << 20;
 ScalarData readPayload(const std::string& path, uint64_t offset, ScalarType type, size_t count,
                        bool bigEndian);
 // Same for compressed data (zlib or gzip stream starting at `offset`): throws BadInput when the
-// stream is corrupt or inflates to fewer bytes than needed.
+// stream is corrupt (its checksum included), ends early, or inflates to fewer or more bytes than
+// needed, and before allocating when `count` exceeds what the compressed bytes can hold.
 ScalarData readCompressedPayload(const std::string& path, uint64_t offset, ScalarType type,
                                  size_t count, bool bigEndian);
+// Bytes a whole zlib/gzip file inflates to, streamed (nothing is kept), checksum checked;
+// BadInput when it is corrupt or ends early.
+uint64_t inflatedSize(const std::string& path);
+// Deflate's largest possible expansion (a long run of one byte): ~1032 to 1.
+inline constexpr uint64_t kMaxDeflateRatio = 1032;
 
 bool hostIsBigEndian();
 void swapBytesInPlace(void* data, size_t count, size_t elementSize);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include <vtkImageData.h>
@@ -37,10 +38,21 @@ T field(const unsigned char* h, size_t offset, bool swap) {
   return v;
 }
 
+// A count that may exceed every integer type (a mutated header's dims multiply to 1e24).
+std::string wholeNumber(double v) {
+  std::ostringstream text;
+  text.precision(15);
+  text << v;
+  return text.str();
+}
+
 void checkNiftiHeader(const std::string& path, uint64_t fileSize) {
   unsigned char h[540] = {};
   const bool gz = endsWithNoCase(path, ".gz");
   size_t got = 0;
+  // A compressed file is inflated once first, streamed: its CRC checked (VTK's reader stops
+  // before the trailer) and its size known before VTK allocates for the data.
+  const uint64_t available = gz ? inflatedSize(path) : fileSize;
   if (gz) {
     gzFile f = gzopen(path.c_str(), "rb");
     if (!f) throwBadInput(path, "cannot open");
@@ -95,11 +107,12 @@ void checkNiftiHeader(const std::string& path, uint64_t fileSize) {
                               : field<float>(h, 76 + 4 * size_t(d), swap);
     if (!std::isfinite(pixdim)) throwBadInput(path, "invalid NIfTI pixdim (not finite)");
   }
-  // The data must be in the file (compressed: checked while inflating, by the reader).
-  if (!gz && offset + bytes > double(fileSize))
-    throwBadInput(path, "truncated: the header describes " + std::to_string(uint64_t(bytes)) +
-                            " bytes of data after offset " + std::to_string(uint64_t(offset)) +
-                            ", the file has " + std::to_string(fileSize) + " bytes");
+  // The data must be in the file before VTK allocates for it.
+  if (offset + bytes > double(available))
+    throwBadInput(path, "truncated: the header describes " + wholeNumber(bytes) +
+                            " bytes of data after offset " + wholeNumber(offset) +
+                            ", the file has " + wholeNumber(double(available)) + " bytes" +
+                            (gz ? " once inflated" : ""));
 }
 
 }  // namespace

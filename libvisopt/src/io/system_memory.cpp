@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -78,8 +79,20 @@ size_t underCgroup() {
 
 }  // namespace
 
+// VISOPT_MEMORY_LIMIT_MB: a cap the user sets on what visopt plans to use (a shared machine; the
+// fuzz targets, whose sanitizer allocator makes setrlimit unusable). Unset or unreadable: none.
+size_t environmentLimit() {
+  const char* text = std::getenv("VISOPT_MEMORY_LIMIT_MB");
+  if (!text || !*text) return kUnknown;
+  char* end = nullptr;
+  const unsigned long long mb = std::strtoull(text, &end, 10);
+  if (*end != '\0' || mb == 0 || mb > (1ull << 40)) return kUnknown;
+  return static_cast<size_t>(mb) << 20;
+}
+
 size_t availableMemoryBytes() {
   size_t room = machineAvailable();
+  room = std::min(room, environmentLimit());
   room = std::min(room, underLimit(RLIMIT_AS, kibField("/proc/self/status", "VmSize:")));
   room = std::min(room, underLimit(RLIMIT_DATA, kibField("/proc/self/status", "VmData:")));
   room = std::min(room, underCgroup());

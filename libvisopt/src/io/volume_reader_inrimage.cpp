@@ -40,12 +40,15 @@ LoadedVolume readInrimage(const std::string& path, const ProgressCallback& progr
   };
 
   VolumeHeader h;
-  h.dims = {int64_t(number("XDIM", 0)), int64_t(number("YDIM", 0)), int64_t(number("ZDIM", 1))};
-  h.components = int(number("VDIM", 1));
+  constexpr int64_t kMaxAxis = int64_t(1) << 40;  // checkHeader refuses what exceeds int
+  h.dims = {headerInteger(path, "XDIM", number("XDIM", 0), 0, kMaxAxis),
+            headerInteger(path, "YDIM", number("YDIM", 0), 0, kMaxAxis),
+            headerInteger(path, "ZDIM", number("ZDIM", 1), 0, kMaxAxis)};
+  h.components = int(headerInteger(path, "VDIM", number("VDIM", 1), 0, 1 << 20));
   h.spacing = {number("VX", 1), number("VY", 1), number("VZ", 1)};
   h.origin = {number("XO", 0), number("YO", 0), number("ZO", 0)};
   const std::string typeText = toLower(fields["TYPE"]);
-  const int bits = int(number("PIXSIZE", 8));
+  const int bits = int(headerInteger(path, "PIXSIZE", number("PIXSIZE", 8), 0, 1024));
   if (typeText == "float" && bits == 32)
     h.type = ScalarType::Float32;
   else if (typeText == "float" && bits == 64)

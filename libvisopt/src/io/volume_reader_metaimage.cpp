@@ -73,7 +73,7 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
   };
 
   int ndims = 3;
-  if (auto v = numbers("NDims", 1)) ndims = int((*v)[0]);
+  if (auto v = numbers("NDims", 1)) ndims = int(headerInteger(path, "NDims", (*v)[0], 0, 64));
   if (ndims < 1 || ndims > 3)
     throwBadInput(path, "NDims = " + std::to_string(ndims) + " is not supported (need 1 to 3)");
   const size_t nd = size_t(ndims);
@@ -82,7 +82,8 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
   auto dims = numbers("DimSize", nd);
   if (!dims) throwBadInput(path, "missing DimSize");
   h.dims = {1, 1, 1};
-  for (size_t a = 0; a < nd; ++a) h.dims[a] = int64_t((*dims)[a]);
+  for (size_t a = 0; a < nd; ++a)
+    h.dims[a] = headerInteger(path, "DimSize", (*dims)[a], 0, int64_t(1) << 40);
   auto spacing = numbers("ElementSpacing", nd);
   if (!spacing) spacing = numbers("ElementSize", nd);
   if (spacing)
@@ -98,7 +99,8 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
         for (size_t r = 0; r < nd; ++r) h.direction[c][r] = (*m)[c * nd + r];
       break;
     }
-  if (auto c = numbers("ElementNumberOfChannels", 1)) h.components = int((*c)[0]);
+  if (auto c = numbers("ElementNumberOfChannels", 1))
+    h.components = int(headerInteger(path, "ElementNumberOfChannels", (*c)[0], 0, 1 << 20));
   auto typeIt = fields.find("ElementType");
   if (typeIt == fields.end()) throwBadInput(path, "missing ElementType");
   auto type = metaElementType(typeIt->second);
@@ -128,7 +130,7 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
     dataOffset = 0;
     if (auto hs = numbers("HeaderSize", 1)) {
       if ((*hs)[0] >= 0) {
-        dataOffset = uint64_t((*hs)[0]);
+        dataOffset = uint64_t(headerInteger(path, "HeaderSize", (*hs)[0], 0, int64_t(1) << 62));
       } else if (!compressed) {  // -1: the data is at the end of the file
         uint64_t dataSize = checkedFileSize(dataFile), need = count * scalarTypeSize(h.type);
         if (dataSize < need)

@@ -147,14 +147,15 @@ LoadedVolume readNrrd(const std::string& path, const ProgressCallback& progress)
       sizes->size() == 4 || (!kinds.empty() && kinds[0] != "domain" && kinds[0] != "space" &&
                              kinds[0] != "time" && sizes->size() >= 3);
   if (firstAxisNonSpatial) {
-    h.components = int((*sizes)[0]);
+    h.components = int(headerInteger(path, "sizes", (*sizes)[0], 0, 1 << 20));
     first = 1;
   }
   const size_t spatial = sizes->size() - first;
   if (spatial < 1 || spatial > 3)
     throwBadInput(path, "dimension " + std::to_string(sizes->size()) + " is not supported");
   h.dims = {1, 1, 1};
-  for (size_t a = 0; a < spatial; ++a) h.dims[a] = int64_t((*sizes)[first + a]);
+  for (size_t a = 0; a < spatial; ++a)
+    h.dims[a] = headerInteger(path, "sizes", (*sizes)[first + a], 0, int64_t(1) << 40);
 
   if (fields.count("space directions")) {
     auto vectors = parseVectors(path, fields["space directions"]);

@@ -55,6 +55,11 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
   if (__builtin_mul_overflow(voxels, sizeof(float), &fp32Bytes))
     throwBadInput(path, "dimensions " + dimsText(h.dims) + " overflow: " + std::to_string(voxels) +
                             " voxels cannot be addressed as fp32");
+  // Voxel centres span the volume's box: a single voxel spans none, and no camera can frame it.
+  if (h.dims[0] == 1 && h.dims[1] == 1 && h.dims[2] == 1)
+    throwBadInput(path,
+                  "a single voxel (1 x 1 x 1): nothing to render; a volume needs two voxels "
+                  "along at least one axis");
   if (h.components != 1)
     throwBadInput(path, "multi-component data (" + std::to_string(h.components) +
                             " components per voxel) is not supported; need one scalar per voxel");

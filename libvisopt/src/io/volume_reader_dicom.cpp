@@ -27,6 +27,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
 
+#include "io/dicom_elements.h"
 #include "io/file_util.h"
 #include "io/vtk_image_reading.h"
 #include "io/vtk_quiet.h"
@@ -122,6 +123,7 @@ LoadedVolume readDicomSeries(const std::string& path, const ProgressCallback& pr
     vtkNew<vtkDICOMImageReader> reader;
     VtkErrorCapture capture(reader);
     if (!reader->CanReadFile(file.c_str())) continue;  // DICOMDIR-less extras, notes, ...
+    checkDicomElements(path, file);
     reader->SetFileName(file.c_str());
     reader->UpdateInformation();
     if (capture.error() || reader->GetErrorCode() != 0)

@@ -798,3 +798,29 @@ TEST(MeshRegression, MalformedPlyHeadersAreRefusedBeforeOpenMeshParsesThem) {
   EXPECT_EQ(sdfFromMesh(good, filledOptions(0.1f), Precision::FP32, nullptr).grid().dims.x > 0,
             true);
 }
+
+// Meshes the libFuzzer targets found (tests/regression/fuzz/fuzz_mesh_*, named for what they
+// did to OpenMesh's readers, the vertex merge or OpenVDB's meshToVolume): each is refused as bad
+// input naming the file, or loads and converts on a 16^3 grid, as in the fuzz target.
+TEST(MeshRegression, LibFuzzerFindingsAreRefusedOrConvert) {
+  int files = 0;
+  const auto root = std::filesystem::path(VISOPT_REGRESSION_DIR) / "fuzz";
+  for (const auto& target : std::filesystem::directory_iterator(root)) {
+    if (target.path().filename().string().rfind("fuzz_mesh_", 0) != 0) continue;
+    for (const auto& entry : std::filesystem::directory_iterator(target.path())) {
+      const std::string path = entry.path().string();
+      MeshSdfOptions options;
+      options.filled = false;
+      options.shellThickness = 0.05f;
+      options.like = GridSpec{glm::ivec3(16)};
+      try {
+        EXPECT_EQ(sdfFromMesh(path, options, Precision::FP32, nullptr).grid().dims.x, 16) << path;
+      } catch (const Error& e) {
+        EXPECT_EQ(e.kind(), ErrorKind::BadInput) << e.what();
+        EXPECT_EQ(std::string(e.what()).rfind(path + ": ", 0), 0u) << e.what();
+      }
+      ++files;
+    }
+  }
+  EXPECT_GE(files, 8);
+}

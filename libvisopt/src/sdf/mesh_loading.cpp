@@ -1,9 +1,12 @@
-// Mesh loading (OpenMesh) and repair. OpenMesh's readers are forgiving: an ASCII OFF file that
-// ends early or holds "nan" loads as a partial mesh, a face with a repeated vertex is dropped
-// with a message on OpenMesh's error stream, and a face that would make an edge non-manifold is
-// added on copies of its vertices. So this file validates what OpenMesh cannot (OFF structure,
-// binary STL size, PLY element counts), captures OpenMesh's error stream, and then repairs and
-// checks the triangle list itself.
+// Mesh loading and repair. OFF and OBJ are parsed here; PLY and STL go through OpenMesh after
+// their structure is checked. OpenMesh's readers are forgiving where a volume tool must not be
+// (an ASCII OFF that ends early loaded as a partial mesh) and unsafe on hostile input (issue 13's
+// fuzz targets: an OFF keyword's counts trusted, an OBJ face without vertices asserted, a short
+// ASCII PLY grew a face without end); a face with a repeated vertex is dropped with a message on
+// OpenMesh's error stream, and a face that would make an edge non-manifold is added on copies of
+// its vertices. So this file validates what OpenMesh reads (binary STL size and values, the PLY
+// header and body), captures OpenMesh's error stream, and then repairs and checks the triangle
+// list itself.
 #include "sdf/mesh_loading.h"
 
 #include <algorithm>
@@ -13,6 +16,7 @@
 #include <fstream>
 #include <iostream>
 #include <mutex>
+#include <regex>
 #include <sstream>
 #include <streambuf>
 #include <unordered_map>
@@ -41,32 +45,42 @@ std::mutex& openMeshStreamMutex() {
   return mutex;
 }
 
-// Routes OpenMesh's error stream into a string (and silences its log) for one load.
+// Routes OpenMesh's error stream into a string (and silences its log) for one load. OpenMesh's
+// stream multiplexer allocates a wrapper at every connect that its disconnect never frees (16
+// bytes per load, found by LeakSanitizer in the mesh fuzz targets), so nothing is disconnected:
+// the capture is connected once per process and emptied per load, and std::cerr, which omerr()
+// also writes to, is pointed at a sink while the load runs. Callers hold openMeshStreamMutex().
 class OpenMeshErrorCapture {
  public:
-  OpenMeshErrorCapture() {
-    reconnectCerr_ = omerr().disconnect(std::cerr);
-    omerr().connect(text_);
-    logWasEnabled_ = omlog().is_enabled();
-    omlog().disable();
+  OpenMeshErrorCapture() : cerr_(std::cerr.rdbuf(sink_.rdbuf())) {
+    stream().str({});
+    stream().clear();
   }
   ~OpenMeshErrorCapture() {
     omerr() << std::flush;
-    omerr().disconnect(text_);
-    if (reconnectCerr_) omerr().connect(std::cerr);
-    if (logWasEnabled_) omlog().enable();
+    std::cerr.rdbuf(cerr_);
   }
   OpenMeshErrorCapture(const OpenMeshErrorCapture&) = delete;
   OpenMeshErrorCapture& operator=(const OpenMeshErrorCapture&) = delete;
 
   std::string text() {
     omerr() << std::flush;
-    return text_.str();
+    return stream().str();
   }
 
  private:
-  std::ostringstream text_;
-  bool reconnectCerr_ = false, logWasEnabled_ = false;
+  static std::ostringstream& stream() {
+    static std::ostringstream* const text = [] {
+      auto* t = new std::ostringstream;  // as long-lived as OpenMesh's own streams
+      omerr().connect(*t);
+      omlog().disable();
+      return t;
+    }();
+    return *text;
+  }
+
+  std::ostringstream sink_;
+  std::streambuf* cerr_;
 };
 
 size_t countOccurrences(const std::string& text, const std::string& what) {
@@ -99,9 +113,21 @@ bool nextContentLine(std::istringstream& in, std::string& line, size_t& lineNumb
   return false;
 }
 
-// Structure check of a plain ASCII "OFF" file: counts, vertex lines with three finite numbers,
-// faces whose indices exist. Variants (COFF, NOFF, binary OFF, ...) are left to OpenMesh.
-void validateAsciiOff(const std::string& path) {
+// Vertices and polygons as a file lists them, before triangulation and repair. `isCopy` marks
+// vertices OpenMesh duplicated itself (to keep a non-manifold vertex manifold).
+struct PolygonSoup {
+  std::vector<glm::vec3> points;
+  std::vector<uint8_t> isCopy;
+  std::vector<std::vector<uint32_t>> faces;
+  size_t droppedFaces = 0;  // faces OpenMesh refused for a repeated vertex
+};
+
+// ASCII OFF, read here rather than by OpenMesh (whose reader trusted a mangled keyword's counts
+// and reserved 17 GB, issue 13's mesh fuzz targets): counts, vertex lines whose first three
+// numbers are finite (texture coordinates, colours or normals may follow), faces whose indices
+// exist. Binary, 4D and n-dimensional variants are refused.
+PolygonSoup parseAsciiOff(const std::string& path) {
+  PolygonSoup soup;
   std::istringstream in(readWholeFile(path));
   std::string line;
   size_t lineNumber = 0;
@@ -109,27 +135,61 @@ void validateAsciiOff(const std::string& path) {
   std::istringstream header(line);
   std::string magic;
   header >> magic;
-  if (magic != "OFF") return;
-  long long counts[3] = {-1, -1, 0};
-  if (!(header >> counts[0])) {
+  // OpenMesh reads "[ST][C][N][4][n]OFF [BINARY]" and trusted whatever it found after a
+  // mangled keyword ("OFFN10..." made it reserve 17 GB). Accepted: ASCII OFF with texture
+  // coordinates, colours or normals after each vertex's x y z.
+  static const std::regex kAsciiVariants("(ST)?C?N?OFF");
+  if (!std::regex_match(magic, kAsciiVariants))
+    throwBadInput(path, std::regex_search(magic, std::regex("^(ST)?C?N?4?n?OFF$"))
+                            ? "4D and n-dimensional OFF files are not supported"
+                            : "not an OFF file (the first line is not an OFF keyword)");
+  if (line.find("BINARY") != std::string::npos)
+    throwBadInput(path, "binary OFF is not supported (save it as ASCII OFF, PLY or STL)");
+  // Counts are whole numbers ("70 6.091" read as 70 vertices and 6 faces).
+  auto count = [](std::istream& words, long long& out) {
+    std::string token;
+    if (!(words >> token) || token.size() > 18 ||
+        token.find_first_not_of("0123456789") != std::string::npos)
+      return false;
+    out = std::stoll(token);
+    return true;
+  };
+  long long counts[2] = {-1, -1};
+  std::string rest;
+  const std::streampos afterMagic = header.tellg();
+  if (!(header >> rest)) {
     if (!nextContentLine(in, line, lineNumber))
       throwBadInput(path, "truncated: the OFF header has no vertex and face counts");
     std::istringstream countLine(line);
-    if (!(countLine >> counts[0] >> counts[1]))
+    if (!count(countLine, counts[0]) || !count(countLine, counts[1]))
       throwBadInput(path,
                     "line " + std::to_string(lineNumber) + ": expected the vertex and face counts");
-  } else if (!(header >> counts[1])) {
-    throwBadInput(path, "line " + std::to_string(lineNumber) + ": expected the face count");
+  } else {
+    header.clear();
+    header.seekg(afterMagic);
+    if (!count(header, counts[0]) || !count(header, counts[1]))
+      throwBadInput(path,
+                    "line " + std::to_string(lineNumber) + ": expected the vertex and face counts");
   }
   const long long nv = counts[0], nf = counts[1];
   if (nv <= 0 || nf <= 0)
     throwBadInput(path, "the OFF header declares " + std::to_string(nv) + " vertices and " +
                             std::to_string(nf) + " faces");
+  // Each vertex and face takes at least two bytes ("0\n"): counts the file cannot hold are
+  // refused before anything is reserved for them.
+  const size_t bytes = in.str().size();
+  if (uint64_t(nv) > bytes / 2 || uint64_t(nf) > bytes / 2)
+    throwBadInput(path, "truncated: the OFF header declares " + std::to_string(nv) +
+                            " vertices and " + std::to_string(nf) + " faces in " +
+                            std::to_string(bytes) + " bytes");
+  soup.points.reserve(size_t(nv));
+  soup.faces.reserve(size_t(nf));
   for (long long v = 0; v < nv; ++v) {
     if (!nextContentLine(in, line, lineNumber))
       throwBadInput(path,
                     "truncated: " + std::to_string(v) + " of " + std::to_string(nv) + " vertices");
     const char* at = line.c_str();
+    glm::vec3 p(0.f);
     for (int c = 0; c < 3; ++c) {
       char* end = nullptr;
       const float x = std::strtof(at, &end);
@@ -138,8 +198,10 @@ void validateAsciiOff(const std::string& path) {
       if (!std::isfinite(x))
         throwBadInput(path, "vertex " + std::to_string(v) + " (line " + std::to_string(lineNumber) +
                                 ") has a NaN or infinite coordinate");
+      p[c] = x;
       at = end;
     }
+    soup.points.push_back(p);
   }
   for (long long f = 0; f < nf; ++f) {
     if (!nextContentLine(in, line, lineNumber))
@@ -147,8 +209,9 @@ void validateAsciiOff(const std::string& path) {
                     "truncated: " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
     std::istringstream face(line);
     long long n = 0;
-    if (!(face >> n) || n < 3)
+    if (!(face >> n) || n < 3 || n > (1 << 16))
       throwBadInput(path, "line " + std::to_string(lineNumber) + ": expected a face (n i1 .. in)");
+    std::vector<uint32_t>& corners = soup.faces.emplace_back();
     for (long long k = 0; k < n; ++k) {
       long long index = -1;
       if (!(face >> index))
@@ -157,8 +220,64 @@ void validateAsciiOff(const std::string& path) {
       if (index < 0 || index >= nv)
         throwBadInput(path, "line " + std::to_string(lineNumber) + ": face refers to vertex " +
                                 std::to_string(index) + " of " + std::to_string(nv));
+      corners.push_back(uint32_t(index));
     }
   }
+  soup.isCopy.assign(soup.points.size(), 0);
+  return soup;
+}
+
+// Wavefront OBJ, read here rather than by OpenMesh (whose reader asserted on a face without a
+// usable vertex and opened whatever an mtllib line named): "v x y z ..." vertices (finite),
+// "f" faces of three or more references "i", "i/t", "i//n" or "i/t/n" (1-based; negative ones
+// count back from the last vertex). Everything else (normals, texture coordinates, groups,
+// materials, lines, points) is skipped; material files are never opened.
+PolygonSoup parseObj(const std::string& path) {
+  PolygonSoup soup;
+  std::istringstream in(readWholeFile(path));
+  std::string line;
+  size_t lineNumber = 0;
+  while (nextContentLine(in, line, lineNumber)) {
+    const char* at = line.c_str();
+    while (*at == ' ' || *at == '\t') ++at;
+    auto where = [&] { return "line " + std::to_string(lineNumber); };
+    if (at[0] == 'v' && (at[1] == ' ' || at[1] == '\t')) {
+      at += 1;
+      glm::vec3 p(0.f);
+      for (int c = 0; c < 3; ++c) {
+        char* end = nullptr;
+        const float x = std::strtof(at, &end);
+        if (end == at) throwBadInput(path, where() + ": expected a vertex (v x y z)");
+        if (!std::isfinite(x))
+          throwBadInput(path, "vertex " + std::to_string(soup.points.size() + 1) + " (" + where() +
+                                  ") has a NaN or infinite coordinate");
+        p[c] = x;
+        at = end;
+      }
+      soup.points.push_back(p);
+    } else if (at[0] == 'f' && (at[1] == ' ' || at[1] == '\t')) {
+      std::istringstream refs(at + 1);
+      std::vector<uint32_t> corners;
+      for (std::string ref; refs >> ref;) {
+        char* end = nullptr;
+        const long long i = std::strtoll(ref.c_str(), &end, 10);
+        if (end == ref.c_str() || (*end != '\0' && *end != '/'))
+          throwBadInput(path, where() + ": malformed face reference \"" + ref.substr(0, 20) + "\"");
+        const long long n = static_cast<long long>(soup.points.size());
+        const long long index = i > 0 ? i - 1 : n + i;
+        if (i == 0 || index < 0 || index >= n)
+          throwBadInput(path, where() + ": face refers to vertex " + std::to_string(i) + " of " +
+                                  std::to_string(n) + " so far");
+        corners.push_back(uint32_t(index));
+        if (corners.size() > (1u << 16)) throwBadInput(path, where() + ": face too large");
+      }
+      if (corners.size() < 3)
+        throwBadInput(path, where() + ": face with fewer than three vertices");
+      soup.faces.push_back(std::move(corners));
+    }
+  }
+  soup.isCopy.assign(soup.points.size(), 0);
+  return soup;
 }
 
 // A binary STL's size is fixed by its triangle count; OpenMesh reads a short one as ASCII.
@@ -200,6 +319,33 @@ void validateStl(const std::string& path, uint64_t size) {
 // version 1.0), comment/obj_info lines, "element NAME COUNT" and "property [list T] T NAME"
 // with PLY's scalar types, then "end_header" within the first 1000 lines; a vertex element with
 // x, y and z and a face element with a vertex_indices list; counts the file's bytes can hold.
+// Then the body is walked element by element (validatePlyBody): OpenMesh's ASCII reader, given
+// fewer values than the header declares, took a failed read for a list length and grew a face
+// without end (an out-of-memory in the mesh fuzz targets).
+struct PlyProperty {
+  bool list = false;
+  std::string countType, type, name;
+};
+struct PlyElement {
+  std::string name;
+  long long count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+size_t plyTypeSize(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "double" || t == "float64") return 8;
+  return 4;  // int, uint, float and their sized names
+}
+
+bool plyTypeIsFloat(const std::string& t) {
+  return t == "float" || t == "double" || t == "float32" || t == "float64";
+}
+
+void validatePlyBody(const std::string& path, std::ifstream& in, uint64_t size, bool ascii,
+                     bool bigEndian, const std::vector<PlyElement>& elements, long long vertices);
+
 void validatePlyHeader(const std::string& path, uint64_t size) {
   static const char* const scalarTypes[] = {
       "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
@@ -228,6 +374,8 @@ void validatePlyHeader(const std::string& path, uint64_t size) {
                   line != "format binary_big_endian 1.0"))
     throwBadInput(
         path, "malformed PLY header: expected a format line, got \"" + line.substr(0, 60) + "\"");
+  const bool ascii = line == "format ascii 1.0", bigEndian = line == "format binary_big_endian 1.0";
+  std::vector<PlyElement> elements;
   std::string element;
   long long vertices = -1, faces = -1;
   bool x = false, y = false, z = false, indices = false, ended = false;
@@ -252,6 +400,7 @@ void validatePlyHeader(const std::string& path, uint64_t size) {
       if (uint64_t(count) > size) bad();
       if (element == "vertex") vertices = count;
       if (element == "face") faces = count;
+      elements.push_back({element, count, {}});
     } else if (word == "property") {
       if (element.empty() || !(words >> a)) bad();
       if (a == "list") {
@@ -260,8 +409,10 @@ void validatePlyHeader(const std::string& path, uint64_t size) {
           bad();
         if (element == "face" && (rest == "vertex_indices" || rest == "vertex_index"))
           indices = true;
+        elements.back().properties.push_back({true, b, c, rest});
       } else {
         if (!isScalar(a) || !(words >> b) || (words >> rest)) bad();
+        elements.back().properties.push_back({false, {}, a, b});
         if (element == "vertex") {
           x = x || b == "x";
           y = y || b == "y";
@@ -277,6 +428,75 @@ void validatePlyHeader(const std::string& path, uint64_t size) {
     throwBadInput(path, "the PLY file has no vertex element with x, y and z");
   if (faces < 0 || !indices)
     throwBadInput(path, "the PLY file has no face element with a vertex_indices list");
+  validatePlyBody(path, in, size, ascii, bigEndian, elements, vertices);
+}
+
+void validatePlyBody(const std::string& path, std::ifstream& in, uint64_t size, bool ascii,
+                     bool bigEndian, const std::vector<PlyElement>& elements, long long vertices) {
+  constexpr long long kMaxListLength = 1 << 16;
+  std::string line;
+  for (const PlyElement& e : elements) {
+    const bool face = e.name == "face";
+    for (long long n = 0; n < e.count; ++n) {
+      auto where = [&] { return e.name + " " + std::to_string(n); };
+      if (ascii) {
+        do {
+          if (!std::getline(in, line))
+            throwBadInput(path, "truncated: " + std::to_string(n) + " of " +
+                                    std::to_string(e.count) + " " + e.name + " lines");
+        } while (line.find_first_not_of(" \t\r") == std::string::npos);
+        std::istringstream values(line);
+        for (const PlyProperty& p : e.properties) {
+          long long length = 1;
+          if (p.list && (!(values >> length) || length < 0 || length > kMaxListLength))
+            throwBadInput(path, where() + ": malformed list length for " + p.name);
+          for (long long k = 0; k < length; ++k) {
+            double v = 0;
+            if (!(values >> v))
+              throwBadInput(path, where() + ": fewer values than its properties declare");
+            if (face && p.list && (v < 0 || v >= double(vertices) || v != std::floor(v)))
+              throwBadInput(path, where() + " refers to vertex " + std::to_string(v) + " of " +
+                                      std::to_string(vertices));
+          }
+        }
+        std::string extra;
+        if (values >> extra)
+          throwBadInput(path, where() + ": more values than its properties declare");
+      } else {
+        for (const PlyProperty& p : e.properties) {
+          uint64_t length = 1;
+          if (p.list) {
+            unsigned char b[8] = {};
+            const size_t bytes = plyTypeSize(p.countType);
+            if (!in.read(reinterpret_cast<char*>(b), std::streamsize(bytes)))
+              throwBadInput(path, "truncated at " + where());
+            length = 0;
+            for (size_t i = 0; i < bytes; ++i)
+              length = (length << 8) | b[bigEndian ? i : bytes - 1 - i];
+            if (length > uint64_t(kMaxListLength))
+              throwBadInput(
+                  path, where() + ": list " + p.name + " of " + std::to_string(length) + " values");
+          }
+          const size_t item = plyTypeSize(p.type);
+          if (face && p.list && !plyTypeIsFloat(p.type)) {
+            for (uint64_t k = 0; k < length; ++k) {
+              unsigned char b[8] = {};
+              if (!in.read(reinterpret_cast<char*>(b), std::streamsize(item)))
+                throwBadInput(path, "truncated at " + where());
+              uint64_t v = 0;
+              for (size_t i = 0; i < item; ++i) v = (v << 8) | b[bigEndian ? i : item - 1 - i];
+              if (v >= uint64_t(vertices))  // negative signed values wrap to huge ones too
+                throwBadInput(path, where() + " refers to a vertex beyond the " +
+                                        std::to_string(vertices) + " declared");
+            }
+          } else {
+            in.seekg(std::streamoff(length * item), std::ios::cur);
+            if (!in || uint64_t(in.tellg()) > size) throwBadInput(path, "truncated at " + where());
+          }
+        }
+      }
+    }
+  }
 }
 
 // "element vertex N" / "element face M" from a PLY header (-1 when absent).
@@ -323,8 +543,12 @@ std::vector<uint32_t> mergeVertices(const std::vector<glm::vec3>& points,
       std::memcpy(b, &p, sizeof b);
       return CellKey{b[0], b[1], b[2]};
     }
-    return CellKey{int64_t(std::floor(double(p.x) / cell)), int64_t(std::floor(double(p.y) / cell)),
-                   int64_t(std::floor(double(p.z) / cell))};
+    // Clamped: a vertex ~1e38 away in a mesh of tiny extent gives a cell index beyond int64
+    // (undefined to convert); far cells sharing a key only cost a distance test.
+    auto index = [&](float x) {
+      return int64_t(std::clamp(std::floor(double(x) / cell), -4.6e18, 4.6e18));
+    };
+    return CellKey{index(p.x), index(p.y), index(p.z)};
   };
   const int reach = cell == 0.0 ? 0 : 1;
   for (size_t v = 0; v < points.size(); ++v) {
@@ -436,66 +660,13 @@ TriangleMesh repairAndCheck(const std::string& path, const std::vector<glm::vec3
   return mesh;
 }
 
-}  // namespace
-
-namespace {
-
-// A seekable stream over a buffer the caller owns (OpenMesh's OBJ reader reads from an
-// std::istream, in two passes: it seeks back to the start).
-struct MemoryBuffer : std::streambuf {
-  MemoryBuffer(char* data, size_t size) { setg(data, data, data + size); }
-  pos_type seekoff(off_type off, std::ios_base::seekdir dir, std::ios_base::openmode) override {
-    char* base = dir == std::ios_base::beg ? eback() : dir == std::ios_base::cur ? gptr() : egptr();
-    char* target = base + off;
-    if (target < eback() || target > egptr()) return pos_type(off_type(-1));
-    setg(eback(), target, egptr());
-    return pos_type(off_type(target - eback()));
-  }
-  pos_type seekpos(pos_type pos, std::ios_base::openmode which) override {
-    return seekoff(off_type(pos), std::ios_base::beg, which);
-  }
-};
-
-// OpenMesh's OBJ reader opens whatever file an `mtllib` line names, relative to the OBJ: a FIFO
-// blocks it for good, a device makes it read forever. A volume tool has no use for materials,
-// so an OBJ is read from memory with those lines turned into comments (line numbers stay).
-bool readObjWithoutMaterials(PolyMesh& mesh, const std::string& path, uint64_t size) {
-  std::string text(size_t(size), '\0');
-  {
-    std::ifstream in(path, std::ios::binary);
-    in.read(text.data(), std::streamsize(size));
-    if (!in) throwBadInput(path, "could not read the whole file");
-  }
-  for (size_t line = 0; line < text.size();) {
-    size_t word = line;
-    while (word < text.size() && (text[word] == ' ' || text[word] == '\t')) ++word;
-    if (text.compare(word, 6, "mtllib") == 0) text[word] = '#';
-    const size_t end = text.find('\n', line);
-    if (end == std::string::npos) break;
-    line = end + 1;
-  }
-  MemoryBuffer buffer(text.data(), text.size());
-  std::istream stream(&buffer);
-  OpenMesh::IO::Options options;
-  return OpenMesh::IO::read_mesh(mesh, stream, ".obj", options);
-}
-
-}  // namespace
-
-TriangleMesh loadMesh(const std::string& path, MeshReport& report, const ProgressCallback& progress,
-                      float progressEnd) {
-  report = MeshReport{};
-  report.path = path;
-  reportProgress(progress, path, 0.f, "load");
-  const uint64_t size = io::checkedFileSize(path);
-  const bool off = io::endsWithNoCase(path, ".off"), stl = io::endsWithNoCase(path, ".stl"),
-             ply = io::endsWithNoCase(path, ".ply"), obj = io::endsWithNoCase(path, ".obj");
-  if (!off && !stl && !ply && !obj)
-    throwBadInput(path, "unsupported mesh format (expected .obj, .ply, .off or .stl)");
-  if (off) validateAsciiOff(path);
-  if (stl) validateStl(path, size);
-  if (ply) validatePlyHeader(path, size);
-
+// PLY and STL through OpenMesh, after their structure was checked (validatePlyHeader walks a
+// PLY's body, validateStl a binary STL's size and values).
+PolygonSoup readWithOpenMesh(const std::string& path, uint64_t size, bool ply) {
+  if (ply)
+    validatePlyHeader(path, size);
+  else
+    validateStl(path, size);
   PolyMesh polyMesh;
   polyMesh.request_vertex_status();
   polyMesh.request_edge_status();
@@ -506,8 +677,7 @@ TriangleMesh loadMesh(const std::string& path, MeshReport& report, const Progres
     std::lock_guard<std::mutex> lock(openMeshStreamMutex());
     OpenMeshErrorCapture capture;
     try {
-      ok = obj ? readObjWithoutMaterials(polyMesh, path, size)
-               : OpenMesh::IO::read_mesh(polyMesh, path);
+      ok = OpenMesh::IO::read_mesh(polyMesh, path);
     } catch (const std::exception& e) {
       ok = false;
       messages = e.what();
@@ -524,12 +694,9 @@ TriangleMesh loadMesh(const std::string& path, MeshReport& report, const Progres
     throwBadInput(path,
                   "a face refers to a vertex that does not exist (malformed or truncated "
                   "file, or an unreadable coordinate such as nan)");
-  if (polyMesh.n_faces() == 0)
-    throwBadInput(path, "the mesh has no faces (empty, truncated or not a mesh)");
-  reportProgress(progress, path, 0.3f * progressEnd, "load");
-
-  std::vector<glm::vec3> points(polyMesh.n_vertices());
-  std::vector<uint8_t> isCopy(points.size(), 0);
+  PolygonSoup soup;
+  soup.points.resize(polyMesh.n_vertices());
+  soup.isCopy.assign(soup.points.size(), 0);
   size_t originalVertices = 0;
   for (auto v : polyMesh.vertices()) {
     const auto& p = polyMesh.point(v);
@@ -537,28 +704,55 @@ TriangleMesh loadMesh(const std::string& path, MeshReport& report, const Progres
     if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z))
       throwBadInput(path,
                     "vertex " + std::to_string(v.idx()) + " has a NaN or infinite coordinate");
-    points[size_t(v.idx())] = q;
-    isCopy[size_t(v.idx())] = polyMesh.status(v).fixed_nonmanifold() ? 1 : 0;
-    originalVertices += isCopy[size_t(v.idx())] ? 0 : 1;
+    soup.points[size_t(v.idx())] = q;
+    soup.isCopy[size_t(v.idx())] = polyMesh.status(v).fixed_nonmanifold() ? 1 : 0;
+    originalVertices += soup.isCopy[size_t(v.idx())] ? 0 : 1;
   }
-  std::vector<glm::uvec3> triangles;
-  triangles.reserve(polyMesh.n_faces());
+  soup.faces.reserve(polyMesh.n_faces());
   for (auto f : polyMesh.faces()) {
-    std::vector<uint32_t> corners;
+    std::vector<uint32_t>& corners = soup.faces.emplace_back();
     for (auto v : polyMesh.fv_range(f)) corners.push_back(uint32_t(v.idx()));
-    for (size_t k = 2; k < corners.size(); ++k)
-      triangles.emplace_back(corners[0], corners[k - 1], corners[k]);
   }
   // OpenMesh drops faces with a repeated vertex before they reach the mesh: degenerate too.
-  const size_t droppedFaces = countOccurrences(messages, "Face has equal vertices");
+  soup.droppedFaces = countOccurrences(messages, "Face has equal vertices");
   if (ply) {
     long long declaredVertices = -1, declaredFaces = -1;
     plyCounts(path, declaredVertices, declaredFaces);
     if ((declaredVertices >= 0 && (long long)originalVertices < declaredVertices) ||
-        (declaredFaces >= 0 && (long long)(polyMesh.n_faces() + droppedFaces) < declaredFaces))
+        (declaredFaces >= 0 && (long long)(polyMesh.n_faces() + soup.droppedFaces) < declaredFaces))
       throwBadInput(path, "truncated: the header declares " + std::to_string(declaredVertices) +
                               " vertices and " + std::to_string(declaredFaces) + " faces");
   }
+  return soup;
+}
+
+}  // namespace
+
+TriangleMesh loadMesh(const std::string& path, MeshReport& report, const ProgressCallback& progress,
+                      float progressEnd) {
+  report = MeshReport{};
+  report.path = path;
+  reportProgress(progress, path, 0.f, "load");
+  const uint64_t size = io::checkedFileSize(path);
+  const bool off = io::endsWithNoCase(path, ".off"), stl = io::endsWithNoCase(path, ".stl"),
+             ply = io::endsWithNoCase(path, ".ply"), obj = io::endsWithNoCase(path, ".obj");
+  if (!off && !stl && !ply && !obj)
+    throwBadInput(path, "unsupported mesh format (expected .obj, .ply, .off or .stl)");
+  PolygonSoup soup = off   ? parseAsciiOff(path)
+                     : obj ? parseObj(path)
+                           : readWithOpenMesh(path, size, ply);
+  if (soup.faces.empty())
+    throwBadInput(path, "the mesh has no faces (empty, truncated or not a mesh)");
+  reportProgress(progress, path, 0.3f * progressEnd, "load");
+
+  std::vector<glm::uvec3> triangles;
+  triangles.reserve(soup.faces.size());
+  for (const std::vector<uint32_t>& corners : soup.faces)
+    for (size_t k = 2; k < corners.size(); ++k)
+      triangles.emplace_back(corners[0], corners[k - 1], corners[k]);
+  const std::vector<glm::vec3>& points = soup.points;
+  const std::vector<uint8_t>& isCopy = soup.isCopy;
+  const size_t droppedFaces = soup.droppedFaces;
   reportProgress(progress, path, 0.5f * progressEnd, "repair");
   TriangleMesh mesh =
       repairAndCheck(path, points, triangles, isCopy, report, progress, progressEnd);

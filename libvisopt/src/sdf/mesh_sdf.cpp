@@ -227,6 +227,27 @@ Field3D sdfFromMesh(const std::string& path, const MeshSdfOptions& options, Prec
   const glm::dmat3 toLocal = glm::transpose(glm::dmat3(grid.direction));
   for (size_t i = 0; i < points.size(); ++i)
     points[i] = glm::vec3(toLocal * (glm::dvec3(mesh.points[i]) - glm::dvec3(grid.origin)) / voxel);
+  // meshToVolume keeps a band 3 voxels to either side of every triangle, wherever it lies, and
+  // indexes voxels with int32: a mesh that reaches far beyond the grid (in other units than the
+  // volume, or a stray vertex) took gigabytes and minutes for a 16^3 grid, or overflowed
+  // OpenVDB's coordinates (the mesh fuzz targets). Such a mesh is refused: it may reach 16 grid
+  // extents past the grid, and its surface's band (area in voxels^2 x 7 voxels, ~64 bytes per
+  // voxel with OpenVDB's temporaries) must fit in memory.
+  const float gridExtent = float(std::max({workDims.x, workDims.y, workDims.z}));
+  const float reach = 16.f * gridExtent;
+  for (const glm::vec3& p : points)
+    if (!(p.x >= -reach && p.y >= -reach && p.z >= -reach && p.x <= float(workDims.x) + reach &&
+          p.y <= float(workDims.y) + reach && p.z <= float(workDims.z) + reach))
+      throwBadInput(path,
+                    "the mesh reaches more than 16 times the grid's size beyond the grid "
+                    "(is it in other units than the volume?)");
+  double area = 0.0;
+  for (const glm::uvec3& t : mesh.triangles)
+    area += 0.5 * glm::length(glm::cross(glm::dvec3(points[t.y]) - glm::dvec3(points[t.x]),
+                                         glm::dvec3(points[t.z]) - glm::dvec3(points[t.x])));
+  if (area * 7.0 * 64.0 > double(availableMemoryBytes()))
+    throwBadInput(path, "the mesh's surface spans " + std::to_string(uint64_t(area)) +
+                            " voxels^2: its distance band would need more memory than there is");
   std::vector<openvdb::Vec3s> vdbPoints(points.size());
   for (size_t i = 0; i < points.size(); ++i)
     vdbPoints[i] = openvdb::Vec3s(points[i].x, points[i].y, points[i].z);

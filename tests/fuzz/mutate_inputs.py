@@ -15,8 +15,8 @@ TOKENS = [b'0', b'-1', b'1e30', b'-3e38', b'nan', b'inf', b'65536', b'2147483647
           b'99999999999', b'1e-30', b'', b' ', b'\n']
 
 
-def volume_seeds(d):
-    nx, ny, nz = 16, 16, 8
+def volume_seeds(d, dims=(16, 16, 8)):
+    nx, ny, nz = dims
     vals = array.array('h', (i % 3000 for i in range(nx * ny * nz)))
     raw = vals.tobytes()
     h = bytearray(348)
@@ -31,25 +31,26 @@ def volume_seeds(d):
     h[344:348] = b'n+1\0'
     seeds = {
         'a.nii': bytes(h) + b'\0' * 4 + raw,
-        'a.mha': b'ObjectType = Image\nNDims = 3\nDimSize = 16 16 8\nElementSpacing = 1 1 2\n'
-                 b'ElementType = MET_SHORT\nElementDataFile = LOCAL\n' + raw,
-        'a.nrrd': b'NRRD0004\ntype: short\ndimension: 3\nsizes: 16 16 8\nspacings: 1 1 2\n'
-                  b'encoding: raw\nendian: little\n\n' + raw,
+        'a.mha': b'ObjectType = Image\nNDims = 3\nDimSize = %d %d %d\nElementSpacing = 1 1 2\n'
+                 b'ElementType = MET_SHORT\nElementDataFile = LOCAL\n' % dims + raw,
+        'a.nrrd': b'NRRD0004\ntype: short\ndimension: 3\nsizes: %d %d %d\nspacings: 1 1 2\n'
+                  b'encoding: raw\nendian: little\n\n' % dims + raw,
     }
     be = array.array('h', vals)
     be.byteswap()
     seeds['a.vtk'] = (b'# vtk DataFile Version 3.0\nx\nBINARY\nDATASET STRUCTURED_POINTS\n'
-                      b'DIMENSIONS 16 16 8\nORIGIN 0 0 0\nSPACING 1 1 2\nPOINT_DATA 2048\n'
-                      b'SCALARS s short 1\nLOOKUP_TABLE default\n' + be.tobytes() + b'\n')
-    inr = (b'#INRIMAGE-4#{\nXDIM=16\nYDIM=16\nZDIM=8\nVDIM=1\nTYPE=signed fixed\n'
-           b'PIXSIZE=16 bits\nCPU=decm\nVX=1\nVY=1\nVZ=2\n')
+                      b'DIMENSIONS %d %d %d\nORIGIN 0 0 0\nSPACING 1 1 2\nPOINT_DATA %d\n'
+                      b'SCALARS s short 1\nLOOKUP_TABLE default\n' % (dims + (nx * ny * nz,)) +
+                      be.tobytes() + b'\n')
+    inr = (b'#INRIMAGE-4#{\nXDIM=%d\nYDIM=%d\nZDIM=%d\nVDIM=1\nTYPE=signed fixed\n'
+           b'PIXSIZE=16 bits\nCPU=decm\nVX=1\nVY=1\nVZ=2\n' % dims)
     seeds['a.inr'] = inr + b'\n' * (252 - len(inr)) + b'##}\n' + raw
     text = ' '.join(str(v) for v in vals)
     seeds['a.vti'] = ('<?xml version="1.0"?>\n<VTKFile type="ImageData" version="0.1" '
-                      'byte_order="LittleEndian">\n<ImageData WholeExtent="0 15 0 15 0 7" '
-                      'Origin="0 0 0" Spacing="1 1 2">\n<Piece Extent="0 15 0 15 0 7">\n'
+                      'byte_order="LittleEndian">\n<ImageData WholeExtent="0 %d 0 %d 0 %d" '
+                      'Origin="0 0 0" Spacing="1 1 2">\n<Piece Extent="0 %d 0 %d 0 %d">\n'
                       '<PointData Scalars="s">\n<DataArray type="Int16" Name="s" format="ascii">\n'
-                      + text + '\n</DataArray>\n</PointData>\n</Piece>\n</ImageData>\n</VTKFile>\n'
+                      % ((nx - 1, ny - 1, nz - 1) * 2) + text + '\n</DataArray>\n</PointData>\n</Piece>\n</ImageData>\n</VTKFile>\n'
                       ).encode()
     for name, data in seeds.items():
         open(os.path.join(d, name), 'wb').write(data)

@@ -29,20 +29,22 @@ class FieldTable {
   // Only the members that differ from S{} (or from `defaults`).
   OrderedJson write(const S& value, const S& defaults = S{}) const {
     OrderedJson out = OrderedJson::object();
-    for (const auto& [key, member] : fields_)
+    // Named pair members, not a structured binding: clang 14 (the fuzzing build) cannot capture
+    // a binding in a lambda.
+    for (const auto& field : fields_)
       std::visit(
           [&](auto m) {
-            if (!(value.*m == defaults.*m)) out[key] = toJson(value.*m);
+            if (!(value.*m == defaults.*m)) out[field.first] = toJson(value.*m);
           },
-          member);
+          field.second);
     return out;
   }
 
   // Every member (for values whose defaults mean nothing, like a camera).
   OrderedJson writeAll(const S& value) const {
     OrderedJson out = OrderedJson::object();
-    for (const auto& [key, member] : fields_)
-      std::visit([&](auto m) { out[key] = toJson(value.*m); }, member);
+    for (const auto& field : fields_)
+      std::visit([&](auto m) { out[field.first] = toJson(value.*m); }, field.second);
     return out;
   }
 
@@ -50,10 +52,10 @@ class FieldTable {
   // addition), wrongly typed values throw BadInput naming `where`.
   void read(const nlohmann::json& j, S& out, const Where& where) const {
     expectObject(j, where);
-    for (const auto& [key, member] : fields_) {
-      auto it = j.find(key);
+    for (const auto& field : fields_) {
+      auto it = j.find(field.first);
       if (it == j.end()) continue;
-      std::visit([&](auto m) { readValue(*it, out.*m, where.key(key)); }, member);
+      std::visit([&](auto m) { readValue(*it, out.*m, where.key(field.first)); }, field.second);
     }
   }
 

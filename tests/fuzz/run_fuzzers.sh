@@ -90,7 +90,9 @@ run_one() {
 export -f run_one
 export BUILD ROOT SECONDS_PER_TARGET RUNS
 
-echo "visopt fuzz: $(wc -w <<<"$TARGETS") targets, ${RUNS:+$RUNS executions}${RUNS:-$SECONDS_PER_TARGET s} each, $JOBS at a time"
+budget_text="$SECONDS_PER_TARGET s"
+[[ -n "$RUNS" ]] && budget_text="$RUNS executions"
+echo "visopt fuzz: $(wc -w <<<"$TARGETS") targets, $budget_text each, $JOBS at a time"
 status=0
 tr ' ' '\n' <<<"$TARGETS" | grep . | xargs -P "$JOBS" -I{} bash -c 'run_one {}' \
   | tee "$BUILD/fuzz-report.txt" || status=1

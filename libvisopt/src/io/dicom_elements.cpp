@@ -69,7 +69,8 @@ class ElementWalk {
         if (e.length == kUndefinedLength)
           fail("compressed (encapsulated) pixel data is not supported");
         checkPixelLength(e.length);
-        return;  // what follows the pixel data is not read by anyone
+        // VTK's parser reads on past the pixel data (an empty element there crashed it): so
+        // does this walk.
       }
     }
   }

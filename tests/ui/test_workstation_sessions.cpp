@@ -557,6 +557,41 @@ void TestWorkstationSessions::movedDataIsFoundAndMissingDataCanBeLocated() {
              QFileInfo(elsewhere).canonicalFilePath());
     QVERIFY(near(w->viewport()->camera(), camera));
   }
+
+  // Back at its place with other content of the same size: the session opens without reading
+  // the file first (sizes only: no question asked), and the content check once the scene shows
+  // reports the change.
+  const QString atPlace = dirB + QStringLiteral("/data/blob.nii");
+  QVERIFY(QFile::copy(elsewhere, atPlace));
+  {
+    QFile f(atPlace);
+    QVERIFY(f.open(QIODevice::ReadWrite));
+    QVERIFY(f.seek(f.size() - 1));
+    char last = 0;
+    QVERIFY(f.getChar(&last));
+    QVERIFY(f.seek(f.size() - 1));
+    QVERIFY(f.putChar(char(last ^ 0x01)));
+  }
+  {
+    auto w = makeWindow(root + QStringLiteral("/state4"));
+    int hookCalls = 0;
+    w->setLocateHook([&](const QString&, const QString&) {
+      ++hookCalls;
+      return QString();
+    });
+    QSignalSpy errors(w.get(), &MainWindow::errorShown);
+    QVERIFY(w->openSession(sessionB));
+    QCOMPARE(hookCalls, 0);
+    QVERIFY(w->waitForSettledFrame(kSettleMs));
+    QTRY_COMPARE_WITH_TIMEOUT(errors.count(), 1, kSettleMs);
+    const QString message = errors.first().first().toString();
+    QVERIFY2(message.contains(QStringLiteral("not the file the session was saved with")),
+             qPrintable(message));
+    std::string source;
+    w->controller()->call([&](Engine& e) { source = e.volume().sourcePath; });
+    QCOMPARE(QFileInfo(QString::fromStdString(source)).canonicalFilePath(),
+             QFileInfo(atPlace).canonicalFilePath());  // still used, as the CLI does
+  }
 }
 
 void TestWorkstationSessions::crashDuringSaveLeavesThePreviousFileIntact() {

@@ -20,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "session/base64.h"
+#include "session/content_hash.h"
 #include "session/sha256.h"
 #include "visopt/engine.h"
 #include "visopt/error.h"
@@ -434,6 +435,101 @@ TEST(Session, MissingAndChangedDataAreReportedNotThrown) {
   EXPECT_THROW(relocate(loaded, "importance", "x"), Error);
 }
 
+// Item 4 of issue 13: a session's data is not read before the session opens. Sizes decide what
+// they can (a size other than the recorded one is Changed unread); the content is hashed later,
+// streamed, with progress and cancel.
+TEST(Session, DataIsMatchedBySizeFirstAndHashedLaterWithProgressAndCancel) {
+  const fs::path dir = freshDir("lazy-hash");
+  const fs::path raw = dir / "vol.raw";
+  writeRawVolume(raw, {8, 8, 8});
+  Engine engine;
+  engine.loadVolume(raw.string());
+  const std::string path = (dir / "s.json").string();
+  saveSession(captureSession(engine, {}, path), path);
+  const Session saved = loadSession(path);
+
+  // Same size, other content: a size check cannot tell and reads nothing.
+  writeRawVolume(raw, {8, 8, 8}, 2.f);
+  EXPECT_FALSE(session::cachedContentHash(raw.string()));
+  std::vector<SessionDataReport> data = checkSessionData(saved, path, DataCheck::Size);
+  ASSERT_EQ(data.size(), 1u);
+  EXPECT_EQ(data[0].status, DataStatus::Ok);
+  EXPECT_FALSE(data[0].contentVerified);
+  EXPECT_NE(describe(data[0]).find("not yet checked"), std::string::npos);
+  EXPECT_FALSE(session::cachedContentHash(raw.string())) << "a size check hashed the file";
+  // Applying with size checks loads the data; verifying afterwards finds the change.
+  Engine lazy;
+  SessionApplyOptions sizes;
+  sizes.check = DataCheck::Size;
+  SessionLoadReport report = applySession(lazy, saved, path, {}, sizes);
+  EXPECT_TRUE(report.sceneLoaded);
+  ASSERT_EQ(report.data.size(), 1u);
+  EXPECT_FALSE(report.data[0].contentVerified);
+  EXPECT_EQ(verifySessionData(report.data), 1u);
+  EXPECT_EQ(report.data[0].status, DataStatus::Changed);
+  EXPECT_TRUE(report.data[0].contentVerified);
+  EXPECT_EQ(verifySessionData(report.data), 0u) << "a verified report is not hashed again";
+
+  // Another size: Changed, from the file system alone, in either mode.
+  writeRawVolume(raw, {8, 8, 9});
+  for (DataCheck mode : {DataCheck::Size, DataCheck::Content}) {
+    const std::vector<SessionDataReport> d = checkSessionData(saved, path, mode);
+    EXPECT_EQ(d[0].status, DataStatus::Changed);
+    EXPECT_TRUE(d[0].contentVerified);
+  }
+  EXPECT_FALSE(session::cachedContentHash(raw.string())) << "a differing size was hashed";
+
+  // The original content back: the content check finds it Ok.
+  writeRawVolume(raw, {8, 8, 8});
+  data = checkSessionData(saved, path, DataCheck::Size);
+  EXPECT_EQ(verifySessionData(data), 0u);
+  EXPECT_EQ(data[0].status, DataStatus::Ok);
+  EXPECT_TRUE(data[0].contentVerified);
+}
+
+TEST(Sha256, HashingReportsProgressAndStopsWhenCancelled) {
+  const fs::path dir = freshDir("hash-progress");
+  const fs::path big = dir / "big.bin";
+  {
+    std::ofstream out(big, std::ios::binary);
+    const std::string mib(1 << 20, 'x');
+    for (int i = 0; i < 40; ++i) out << mib;  // 40 MiB: reported at 16 and 32 MiB
+  }
+  // Cancelled at the first report: Cancelled, and nothing cached.
+  int calls = 0;
+  try {
+    makeDataReference(big.string(), {}, [&](float, const std::string&) { return ++calls > 1; });
+    ADD_FAILURE() << "not cancelled";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Cancelled);
+    EXPECT_NE(std::string(e.what()).find("big.bin"), std::string::npos);
+  }
+  EXPECT_EQ(calls, 1);
+  EXPECT_FALSE(session::cachedContentHash(big.string()));
+  // Through: fractions rise within (0, 1]; the stage names the file.
+  std::vector<float> fractions;
+  const DataReference ref =
+      makeDataReference(big.string(), {}, [&](float f, const std::string& stage) {
+        EXPECT_NE(stage.find("big.bin"), std::string::npos);
+        fractions.push_back(f);
+        return true;
+      });
+  ASSERT_EQ(fractions.size(), 2u);
+  EXPECT_NEAR(fractions[0], 16.f / 40.f, 1e-6f);
+  EXPECT_NEAR(fractions[1], 32.f / 40.f, 1e-6f);
+  EXPECT_EQ(ref.bytes, 40u << 20);
+  ASSERT_TRUE(session::cachedContentHash(big.string()));
+  EXPECT_EQ(session::cachedContentHash(big.string())->sha256, ref.sha256);
+  // A cancelled verification leaves the report unverified.
+  std::vector<SessionDataReport> data{{"volume", ref, DataStatus::Ok, big.string(), {}, false}};
+  std::ofstream(big, std::ios::binary | std::ios::app) << "";  // same bytes, newer time
+  fs::last_write_time(big, fs::last_write_time(big) + std::chrono::seconds(1));
+  EXPECT_THROW(verifySessionData(data, [](float, const std::string&) { return false; }), Error);
+  EXPECT_FALSE(data[0].contentVerified);
+  EXPECT_EQ(verifySessionData(data), 0u);
+  EXPECT_TRUE(data[0].contentVerified);
+}
+
 TEST(Session, CrashMidSaveLeavesThePreviousFileIntact) {
   const fs::path dir = freshDir("crash");
   const std::string path = (dir / "s.json").string();
@@ -537,6 +633,14 @@ TEST(Session, CliRendersASessionAndDescribesIt) {
   e.loadVolume(raw.string());
   const std::string gone = (dir / "gone.json").string();
   saveSession(captureSession(e, render, gone), gone);
+  // Present: the content is compared, or with --sizes-only only the size.
+  for (const std::string flag : {"", " --sizes-only"}) {
+    r = runCli("session-info " + gone + " --json" + flag);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto file = nlohmann::json::parse(r.out)["data"][0];
+    EXPECT_EQ(file["status"], "ok");
+    EXPECT_EQ(file["content_verified"], flag.empty()) << flag;
+  }
   fs::remove(raw);
   r = runCli("render --session " + gone + " --out " + png);
   EXPECT_EQ(r.code, 2);

@@ -583,8 +583,16 @@ void MainWindow::openBuiltinScene(const QString& name, int resolution) {
 
 void MainWindow::openVolume(const QString& path) {
   const std::string p = path.toStdString();
-  replaceScene(tr("Volume %1").arg(path),
-               [p](Engine& e, const ProgressCallback& progress) { e.loadVolume(p, progress); });
+  replaceScene(tr("Volume %1").arg(path), [p](Engine& e, const ProgressCallback& progress) {
+    e.loadVolume(p, progress);
+    // The content hash a saved session records, computed now with progress (and
+    // cached), so that saving later reads nothing; cancelling it only defers it.
+    try {
+      makeDataReference(p, {}, progress);
+    } catch (const Error& err) {
+      if (err.kind() != ErrorKind::Cancelled) throw;
+    }
+  });
 }
 
 void MainWindow::replaceScene(const QString& title,
@@ -789,8 +797,10 @@ bool MainWindow::openSession(const QString& path) {
     showError(QString::fromUtf8(e.what()));
     return false;
   }
-  // Data that moved or vanished: ask where it is before anything is replaced.
-  for (const SessionDataReport& r : checkSessionData(session, p)) {
+  // Data that moved or vanished: ask where it is before anything is replaced. Only sizes are
+  // compared here (no file is read on the interface's thread); the content is hashed once the
+  // scene shows.
+  for (const SessionDataReport& r : checkSessionData(session, p, DataCheck::Size)) {
     if (r.status == DataStatus::Ok || r.status == DataStatus::Moved) continue;
     const QString role = fromStd(r.role);
     const QString recorded = fromStd(r.reference.absolutePath);
@@ -816,10 +826,18 @@ bool MainWindow::openSession(const QString& path) {
   auto shared = std::make_shared<Session>(std::move(session));
   controller_->postLong(tr("Session %1").arg(QFileInfo(path).fileName()),
                         [this, shared, p](Engine& e, const ProgressCallback& progress) {
-                          const SessionLoadReport report = applySession(e, *shared, p, progress);
+                          SessionApplyOptions options;
+                          options.check = DataCheck::Size;
+                          SessionLoadReport report = applySession(e, *shared, p, progress, options);
                           e.resetOptimization();
                           controller_->refreshSnapshot(e, true);
                           QStringList problems;
+                          try {
+                            verifySessionData(report.data, progress);
+                          } catch (const Error& err) {
+                            if (err.kind() != ErrorKind::Cancelled) throw;
+                            problems << tr("The data files' content was not checked (cancelled).");
+                          }
                           for (const auto& d : report.data)
                             if (d.status != DataStatus::Ok && d.status != DataStatus::Moved)
                               problems << fromStd(describe(d));

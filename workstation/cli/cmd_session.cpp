@@ -16,7 +16,8 @@ nlohmann::json referenceJson(const SessionDataReport& d) {
           {"relative", d.reference.relativePath},
           {"resolved", d.resolvedPath},
           {"sha256", d.reference.sha256},
-          {"bytes", d.reference.bytes}};
+          {"bytes", d.reference.bytes},
+          {"content_verified", d.contentVerified}};
 }
 
 }  // namespace
@@ -25,13 +26,18 @@ Runner addSessionInfoCommand(CLI::App& app) {
   struct Options {
     std::string file;
     bool json = false;
+    bool sizesOnly = false;
   };
   auto o = std::make_shared<Options>();
   app.add_option("file", o->file, "Session file")->required();
   app.add_flag("--json", o->json, "Print one JSON object");
+  app.add_flag("--sizes-only", o->sizesOnly,
+               "Compare the data files' sizes with the recorded ones, without reading them "
+               "(default: their content hashes are compared too)");
   return [o]() {
     const Session s = loadSession(o->file);
-    const std::vector<SessionDataReport> data = checkSessionData(s, o->file);
+    const std::vector<SessionDataReport> data =
+        checkSessionData(s, o->file, o->sizesOnly ? DataCheck::Size : DataCheck::Content);
     size_t maskSet = 0;
     if (s.worldMask)
       for (size_t i = 0; i < s.worldMask->voxelCount(); ++i) maskSet += s.worldMask->get(i);

@@ -54,8 +54,10 @@ struct DataReference {
 
 // Describes `path` (made absolute) for a session to be saved at `sessionPath` (relativePath stays
 // empty when sessionPath is empty). Hashes the content; results are cached per (path, size,
-// modification time) for the life of the process. Throws BadInput when `path` is unreadable.
-DataReference makeDataReference(const std::string& path, const std::string& sessionPath);
+// modification time) for the life of the process. Throws BadInput when `path` is unreadable;
+// `progress` hears the hashing, and returning false throws Error(Cancelled).
+DataReference makeDataReference(const std::string& path, const std::string& sessionPath,
+                                const ProgressCallback& progress = {});
 // Recomputes relativePath for a session saved at a new place.
 DataReference rebaseDataReference(DataReference ref, const std::string& sessionPath);
 
@@ -68,13 +70,26 @@ enum class DataStatus {
 };
 const char* toString(DataStatus status);
 
+// How much of a data file is read to decide that it is the one a session was saved with.
+enum class DataCheck {
+  Content,  // its SHA-256 (streamed; a file already hashed unchanged by this process is not reread)
+  Size,     // its size only, from the file system; the content is checked later (verifySessionData)
+};
+
 struct DataResolution {
   DataStatus status = DataStatus::Missing;
   std::string resolvedPath;  // empty when Missing
+  // The verdict is final: decided by the content hash, a size that differs, or absence; false
+  // when DataCheck::Size found the recorded size and the content is still to be checked.
+  bool contentVerified = false;
 };
 // Absolute path first, then the relative path against the session's folder; a candidate whose
-// hash matches wins over one that exists with other content.
-DataResolution resolveDataReference(const DataReference& ref, const std::string& sessionPath);
+// hash matches wins over one that exists with other content. A candidate whose size differs from
+// the recorded `bytes` is Changed without being read. `progress` hears the hashing; returning
+// false throws Error(Cancelled).
+DataResolution resolveDataReference(const DataReference& ref, const std::string& sessionPath,
+                                    DataCheck check = DataCheck::Content,
+                                    const ProgressCallback& progress = {});
 
 // ---- the session ---------------------------------------------------------------------------
 
@@ -126,7 +141,8 @@ struct SessionDataReport {
   DataReference reference;
   DataStatus status = DataStatus::Missing;
   std::string resolvedPath;
-  std::string message;  // Unreadable: why
+  std::string message;           // Unreadable: why
+  bool contentVerified = false;  // see DataResolution; false after a DataCheck::Size check
 };
 
 // One line for people: "volume: moved: found at /new/ct.nii.gz through ../data/ct.nii.gz".
@@ -145,12 +161,24 @@ struct SessionLoadReport {
 struct SessionApplyOptions {
   // A file whose content changed is still used (and reported as Changed); false skips it.
   bool useChangedFiles = true;
+  // Content: every data file is hashed before it is loaded. Size: files whose size matches are
+  // loaded at once and their content is checked afterwards with verifySessionData (what the
+  // workstation does, so a session of large data opens without reading it twice first).
+  DataCheck check = DataCheck::Content;
 };
 
 // Resolves every data reference without touching an engine (what a workstation shows before it
-// asks the user to point to moved files).
+// asks the user to point to moved files). DataCheck::Size reads no file.
 std::vector<SessionDataReport> checkSessionData(const Session& session,
-                                                const std::string& sessionPath);
+                                                const std::string& sessionPath,
+                                                DataCheck check = DataCheck::Content,
+                                                const ProgressCallback& progress = {});
+// Hashes each report that is Ok or Moved without its content verified (a DataCheck::Size check)
+// and sets it to Changed when the hash differs from the one recorded; returns how many changed.
+// An unreadable file becomes Unreadable. `progress` spans all the bytes to hash; returning false
+// throws Error(Cancelled) and leaves the reports not yet checked as they were.
+size_t verifySessionData(std::vector<SessionDataReport>& data,
+                         const ProgressCallback& progress = {});
 // Points the reference of `role` (as in SessionDataReport) at `newPath`, keeping its recorded
 // hash, so the next apply finds it (reported Ok or Changed). Throws Usage for an unknown role.
 void relocate(Session& session, const std::string& role, const std::string& newPath);

@@ -51,7 +51,12 @@ std::vector<FileEntry> listEntries(const std::string& path) {
   return entries;
 }
 
-void hashFile(Sha256& h, const fs::path& path) {
+constexpr size_t kChunkBytes = size_t(1) << 20;
+constexpr uint64_t kReportEveryBytes = uint64_t(16) << 20;
+
+// Streams `path` into `h`; `onChunk(bytes)` after every chunk.
+template <class OnChunk>
+void hashFile(Sha256& h, const fs::path& path, OnChunk&& onChunk) {
   // Only regular files: a session must not make visopt read a device (/dev/zero never ends)
   // or block on a FIFO.
   std::error_code ec;
@@ -59,9 +64,12 @@ void hashFile(Sha256& h, const fs::path& path) {
     throwBadInput(path.string(), "is not a regular file; only data files are checked");
   std::unique_ptr<FILE, int (*)(FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!f) throwBadInput(path.string(), std::string("cannot open: ") + std::strerror(errno));
-  std::vector<char> buffer(1 << 20);
+  std::vector<char> buffer(kChunkBytes);
   size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), f.get())) > 0) h.update(buffer.data(), n);
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), f.get())) > 0) {
+    h.update(buffer.data(), n);
+    onChunk(n);
+  }
   if (std::ferror(f.get())) throwBadInput(path.string(), "read error");
 }
 
@@ -77,21 +85,58 @@ struct CacheEntry {
   ContentHash hash;
 };
 
+std::mutex cacheMutex;
+std::map<std::string, CacheEntry> cache;
+
+struct Listing {
+  std::vector<FileEntry> entries;
+  bool folder = false;
+  std::string key, signature;
+  uint64_t bytes = 0;
+};
+
+Listing list(const std::string& path) {
+  Listing l;
+  std::error_code ec;
+  l.key = fs::absolute(path, ec).lexically_normal().string();
+  l.entries = listEntries(path);
+  l.folder = l.entries.empty() || !l.entries.front().name.empty();
+  l.signature = std::string(l.folder ? "dir\n" : "file\n") + signatureOf(l.entries);
+  for (const auto& e : l.entries) l.bytes += e.size;
+  return l;
+}
+
+std::optional<ContentHash> lookUp(const Listing& l) {
+  std::lock_guard<std::mutex> lock(cacheMutex);
+  auto it = cache.find(l.key);
+  if (it != cache.end() && it->second.signature == l.signature) return it->second.hash;
+  return std::nullopt;
+}
+
 }  // namespace
 
-ContentHash hashContent(const std::string& path) {
-  static std::mutex mutex;
-  static std::map<std::string, CacheEntry> cache;
-  std::error_code ec;
-  const std::string key = fs::absolute(path, ec).lexically_normal().string();
-  const std::vector<FileEntry> entries = listEntries(path);
-  const bool folder = entries.empty() || !entries.front().name.empty();
-  const std::string signature = std::string(folder ? "dir\n" : "file\n") + signatureOf(entries);
-  {
-    std::lock_guard<std::mutex> lock(mutex);
-    auto it = cache.find(key);
-    if (it != cache.end() && it->second.signature == signature) return it->second.hash;
-  }
+uint64_t contentBytes(const std::string& path) {
+  return list(path).bytes;
+}
+
+std::optional<ContentHash> cachedContentHash(const std::string& path) {
+  return lookUp(list(path));
+}
+
+ContentHash hashContent(const std::string& path, const ProgressCallback& progress) {
+  const Listing listing = list(path);
+  if (auto hit = lookUp(listing)) return *hit;
+  const std::vector<FileEntry>& entries = listing.entries;
+  const bool folder = listing.folder;
+  uint64_t done = 0, reported = 0;
+  auto onChunk = [&](size_t n) {
+    done += n;
+    if (!progress || done - reported < kReportEveryBytes) return;
+    reported = done;
+    const float fraction = float(double(done) / double(std::max<uint64_t>(listing.bytes, done)));
+    if (!progress(fraction, "checking " + path))
+      throw Error(ErrorKind::Cancelled, path + ": checking its content was cancelled");
+  };
   Sha256 h;
   ContentHash out;
   for (const auto& e : entries) {
@@ -101,12 +146,12 @@ ContentHash hashContent(const std::string& path) {
       for (int i = 0; i < 8; ++i) size[i] = uint8_t(e.size >> (8 * i));
       h.update(size, sizeof(size));
     }
-    hashFile(h, e.path);
+    hashFile(h, e.path, onChunk);
     out.bytes += e.size;
   }
   out.sha256 = h.hexDigest();
-  std::lock_guard<std::mutex> lock(mutex);
-  cache[key] = {signature, out};
+  std::lock_guard<std::mutex> lock(cacheMutex);
+  cache[listing.key] = {listing.signature, out};
   return out;
 }
 

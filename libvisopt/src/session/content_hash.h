@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
+
+#include "visopt/progress.h"
 
 namespace visopt::session {
 
@@ -14,7 +17,16 @@ struct ContentHash {
 
 // A regular file: SHA-256 of its bytes. A folder: of its regular files (not recursive) in name
 // order, each contributing its name, a NUL, its size as 8 little-endian bytes, and its bytes.
-// Throws BadInput "PATH: ..." when the path does not exist or cannot be read.
-ContentHash hashContent(const std::string& path);
+// Throws BadInput "PATH: ..." when the path does not exist or cannot be read. `progress` hears
+// the fraction of bytes hashed (about every 16 MiB); returning false throws Error(Cancelled).
+ContentHash hashContent(const std::string& path, const ProgressCallback& progress = {});
+
+// The bytes hashContent would read (a folder: the sum over its regular files), from the file
+// system's metadata alone. Throws as hashContent does.
+uint64_t contentBytes(const std::string& path);
+
+// The hash of `path` when this process has already computed it for the file's current size and
+// modification time; nothing is read.
+std::optional<ContentHash> cachedContentHash(const std::string& path);
 
 }  // namespace visopt::session

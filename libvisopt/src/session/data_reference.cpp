@@ -12,8 +12,9 @@ namespace visopt {
 
 namespace fs = std::filesystem;
 
-DataReference makeDataReference(const std::string& path, const std::string& sessionPath) {
-  const session::ContentHash hash = session::hashContent(path);
+DataReference makeDataReference(const std::string& path, const std::string& sessionPath,
+                                const ProgressCallback& progress) {
+  const session::ContentHash hash = session::hashContent(path, progress);
   DataReference ref;
   ref.absolutePath = session::absolutePath(path);
   ref.sha256 = hash.sha256;
@@ -43,7 +44,8 @@ const char* toString(DataStatus status) {
   return "?";
 }
 
-DataResolution resolveDataReference(const DataReference& ref, const std::string& sessionPath) {
+DataResolution resolveDataReference(const DataReference& ref, const std::string& sessionPath,
+                                    DataCheck check, const ProgressCallback& progress) {
   struct Candidate {
     std::string path;
     DataStatus whenSame;
@@ -60,17 +62,26 @@ DataResolution resolveDataReference(const DataReference& ref, const std::string&
   for (const Candidate& c : candidates) {
     std::error_code ec;
     if (!fs::exists(c.path, ec)) continue;
-    std::string sha;
     try {
-      sha = session::hashContent(c.path).sha256;
-    } catch (const Error&) {
-      return {DataStatus::Unreadable, c.path};
+      // A size other than the recorded one settles it without reading the file (sessions
+      // written before sizes were recorded say 0: those are hashed).
+      if (ref.bytes != 0 && session::contentBytes(c.path) != ref.bytes) {
+        if (!changed) changed = c.path;
+        continue;
+      }
+      if (ref.sha256.empty()) return {c.whenSame, c.path, true};
+      std::optional<session::ContentHash> hash = session::cachedContentHash(c.path);
+      if (!hash && check == DataCheck::Size) return {c.whenSame, c.path, false};
+      if (!hash) hash = session::hashContent(c.path, progress);
+      if (hash->sha256 == ref.sha256) return {c.whenSame, c.path, true};
+    } catch (const Error& e) {
+      if (e.kind() == ErrorKind::Cancelled) throw;
+      return {DataStatus::Unreadable, c.path, true};
     }
-    if (ref.sha256.empty() || sha == ref.sha256) return {c.whenSame, c.path};
     if (!changed) changed = c.path;
   }
-  if (changed) return {DataStatus::Changed, *changed};
-  return {DataStatus::Missing, {}};
+  if (changed) return {DataStatus::Changed, *changed, true};
+  return {DataStatus::Missing, {}, true};
 }
 
 }  // namespace visopt

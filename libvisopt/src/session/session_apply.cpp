@@ -1,9 +1,12 @@
 // Rebuilding a session in an Engine. Data that cannot be found or read is reported, never
 // thrown; whatever can be applied is. Without its data source nothing is applied, so the engine
 // keeps the scene it had and the caller can relocate the file and apply again.
+#include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "session/content_hash.h"
 #include "session/paths.h"
 #include "session/surface_source.h"
 #include "visopt/error.h"
@@ -19,9 +22,10 @@ std::string surfaceRole(size_t index) {
 }
 
 SessionDataReport check(const std::string& role, const DataReference& ref,
-                        const std::string& sessionPath) {
-  const DataResolution r = resolveDataReference(ref, sessionPath);
-  return {role, ref, r.status, r.resolvedPath, {}};
+                        const std::string& sessionPath, DataCheck mode,
+                        const ProgressCallback& progress) {
+  const DataResolution r = resolveDataReference(ref, sessionPath, mode, progress);
+  return {role, ref, r.status, r.resolvedPath, {}, r.contentVerified};
 }
 
 bool usable(const SessionDataReport& d, const SessionApplyOptions& options) {
@@ -71,15 +75,56 @@ bool SessionLoadReport::allDataFound() const {
 }
 
 std::vector<SessionDataReport> checkSessionData(const Session& session,
-                                                const std::string& sessionPath) {
-  std::vector<SessionDataReport> out;
-  if (session.builtinScene.empty()) out.push_back(check("volume", session.volume, sessionPath));
+                                                const std::string& sessionPath, DataCheck mode,
+                                                const ProgressCallback& progress) {
+  std::vector<std::pair<std::string, const DataReference*>> refs;
+  if (session.builtinScene.empty()) refs.emplace_back("volume", &session.volume);
   if (session.importance.kind == SessionImportance::Kind::Volume)
-    out.push_back(check("importance", session.importance.volume, sessionPath));
+    refs.emplace_back("importance", &session.importance.volume);
   for (size_t i = 0; i < session.contextSurfaces.size(); ++i)
     if (!session.contextSurfaces[i].file.empty())
-      out.push_back(check(surfaceRole(i), session.contextSurfaces[i].file, sessionPath));
+      refs.emplace_back(surfaceRole(i), &session.contextSurfaces[i].file);
+  const Stages stages(progress);
+  std::vector<SessionDataReport> out;
+  for (size_t i = 0; i < refs.size(); ++i) {
+    const float from = float(i) / float(refs.size()), to = float(i + 1) / float(refs.size());
+    out.push_back(check(refs[i].first, *refs[i].second, sessionPath, mode, stages.span(from, to)));
+  }
   return out;
+}
+
+size_t verifySessionData(std::vector<SessionDataReport>& data, const ProgressCallback& progress) {
+  auto pending = [](const SessionDataReport& d) {
+    return !d.contentVerified && !d.reference.sha256.empty() &&
+           (d.status == DataStatus::Ok || d.status == DataStatus::Moved);
+  };
+  uint64_t total = 0, done = 0;
+  for (const auto& d : data)
+    if (pending(d)) total += d.reference.bytes;
+  size_t changed = 0;
+  for (auto& d : data) {
+    if (!pending(d)) continue;
+    const uint64_t bytes = d.reference.bytes;
+    const ProgressCallback span =
+        !progress ? ProgressCallback{} : ProgressCallback([&](float f, const std::string& stage) {
+          return progress(
+              float((double(done) + f * double(bytes)) / double(std::max<uint64_t>(total, 1))),
+              d.role + ": " + stage);
+        });
+    try {
+      if (session::hashContent(d.resolvedPath, span).sha256 != d.reference.sha256) {
+        d.status = DataStatus::Changed;
+        ++changed;
+      }
+    } catch (const Error& e) {
+      if (e.kind() == ErrorKind::Cancelled) throw;
+      d.status = DataStatus::Unreadable;
+      d.message = e.what();
+    }
+    d.contentVerified = true;
+    done += bytes;
+  }
+  return changed;
 }
 
 void relocate(Session& session, const std::string& role, const std::string& newPath) {
@@ -104,7 +149,8 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
 
   // The data source; without it nothing else applies.
   if (!session.builtinScene.empty()) {
-    SessionDataReport d{"volume", {}, DataStatus::Ok, "builtin:" + session.builtinScene, {}};
+    SessionDataReport d{"volume", {},  DataStatus::Ok, "builtin:" + session.builtinScene,
+                        {},       true};  // nothing to hash
     d.reference.absolutePath = d.resolvedPath;
     // The scene's own surfaces only when the session says nothing of surfaces or transfer
     // function (a hand-written one); a captured session lists every surface it had.
@@ -119,9 +165,10 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
     report.data.push_back(d);
     if (d.status != DataStatus::Ok) return report;
   } else {
-    SessionDataReport d = check("volume", session.volume, sessionPath);
+    SessionDataReport d =
+        check("volume", session.volume, sessionPath, options.check, stages.span(0.f, 0.1f));
     if (usable(d, options) &&
-        !attempt([&] { engine.loadVolume(d.resolvedPath, stages.span(0.f, 0.6f)); }, d.message))
+        !attempt([&] { engine.loadVolume(d.resolvedPath, stages.span(0.1f, 0.6f)); }, d.message))
       d.status = DataStatus::Unreadable;
     report.data.push_back(d);
     if (!usable(d, options) || d.status == DataStatus::Unreadable) return report;
@@ -150,7 +197,8 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
       warnIfFails("importance", [&] { engine.setImportanceCurve(session.importance.curve); });
       break;
     case SessionImportance::Kind::Volume: {
-      SessionDataReport d = check("importance", session.importance.volume, sessionPath);
+      SessionDataReport d = check("importance", session.importance.volume, sessionPath,
+                                  options.check, stages.span(0.6f, 0.65f));
       if (usable(d, options) && !attempt([&] { engine.loadImportance(d.resolvedPath); }, d.message))
         d.status = DataStatus::Unreadable;
       report.data.push_back(d);
@@ -167,10 +215,12 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
     stages.at(from, "session: " + surfaceRole(i));
     ContextSurfaceSpec spec = session.contextSurfaces[i].spec;
     if (!session.contextSurfaces[i].file.empty()) {
-      SessionDataReport d = check(surfaceRole(i), session.contextSurfaces[i].file, sessionPath);
+      const float checked = from + 0.2f * (to - from);
+      SessionDataReport d = check(surfaceRole(i), session.contextSurfaces[i].file, sessionPath,
+                                  options.check, stages.span(from, checked));
       if (usable(d, options)) {
         spec.source = session::withSurfaceFile(spec.source, d.resolvedPath);
-        if (!attempt([&] { engine.addContextSurface(spec, stages.span(from, to)); }, d.message))
+        if (!attempt([&] { engine.addContextSurface(spec, stages.span(checked, to)); }, d.message))
           d.status = DataStatus::Unreadable;
       }
       report.data.push_back(d);

@@ -7,12 +7,14 @@ std::string describe(const SessionDataReport& d) {
   const DataReference& ref = d.reference;
   const std::string named = !ref.absolutePath.empty() ? ref.absolutePath : ref.relativePath;
   std::string text = d.role + ": " + toString(d.status) + ": ";
+  const std::string unverified =
+      d.contentVerified ? std::string() : " (its size matches; its content is not yet checked)";
   switch (d.status) {
     case DataStatus::Ok:
-      return text + d.resolvedPath;
+      return text + d.resolvedPath + unverified;
     case DataStatus::Moved:
       return text + "not at " + ref.absolutePath + "; found at " + d.resolvedPath + " through " +
-             ref.relativePath;
+             ref.relativePath + unverified;
     case DataStatus::Changed:
       return text + d.resolvedPath +
              " is not the file the session was saved with (its content "

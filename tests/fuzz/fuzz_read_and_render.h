@@ -10,9 +10,8 @@
 #include <utility>
 
 #include "fuzz_input_file.h"
-#include "visopt/engine.h"
+#include "smallest_render.h"
 #include "visopt/error.h"
-#include "visopt/render_settings.h"
 #include "visopt/volume_io.h"
 
 namespace visopt::fuzz {
@@ -21,13 +20,7 @@ inline void readAndRender(const std::string& path) {
   try {
     Volume volume = readVolume(path, Precision::FP32);
     if (!downstreamChecks()) return;
-    Engine engine;
-    engine.setVolume(std::move(volume));
-    RenderSettings settings;
-    settings.width = settings.height = 16;
-    settings.lightGridSize = kMinLightGridSize;
-    engine.setViewportSize(16, 16);
-    (void)engine.render(settings);
+    (void)renderSmallest(std::move(volume));
   } catch (const Error& e) {
     expectBadInput(e);
   }

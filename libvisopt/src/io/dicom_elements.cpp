@@ -63,9 +63,11 @@ class ElementWalk {
     in_.seekg(128);
     in_.read(magic, 4);
     pos_ = in_.gcount() == 4 && std::memcmp(magic, "DICM", 4) == 0 ? 132 : 0;
+    bool pixelData = false;
     while (pos_ < size_) {
       const Element e = next();
       if (e.tag == tagOf(0x7FE0, 0x0010)) {
+        pixelData = true;
         if (e.length == kUndefinedLength)
           fail("compressed (encapsulated) pixel data is not supported");
         checkPixelLength(e.length);
@@ -73,6 +75,7 @@ class ElementWalk {
         // does this walk.
       }
     }
+    if (!pixelData) fail("no pixel data");
   }
 
  private:

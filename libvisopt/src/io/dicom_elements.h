@@ -4,7 +4,8 @@
 // without checking that there are any (a Columns element of length 0 crashed it). Checked here:
 // every element's value lies within the file, sequences and items of undefined length close,
 // the elements vtkDICOMImageReader reads have values (two bytes for the unsigned shorts), and the
-// pixel data is not encapsulated (compressed). Throws BadInput "FOLDER: FILE: problem".
+// pixel data is present, not encapsulated (compressed) and exactly the image's size. Throws
+// BadInput "FOLDER: FILE: problem".
 #pragma once
 
 #include <string>

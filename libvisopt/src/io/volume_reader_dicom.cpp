@@ -14,7 +14,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <utility>
@@ -65,37 +64,6 @@ struct Slice {
   double position[3] = {0, 0, 0};
   double along = 0;  // position . normal
 };
-
-// vtkDICOMImageReader reads short pixel data without complaint: find the last PixelData element
-// (7FE0,0010) and check that the length it declares is present in the file.
-void checkPixelData(const std::string& folder, const std::string& file, size_t minBytes) {
-  const uint64_t size = checkedFileSize(file);
-  std::ifstream in(file, std::ios::binary);
-  // Headers are small: the element sits in the first 64 KiB.
-  std::string tail(static_cast<size_t>(std::min<uint64_t>(size, 1 << 16)), '\0');
-  in.read(tail.data(), std::streamsize(tail.size()));
-  const std::string tag("\xE0\x7F\x10\x00", 4);
-  size_t at = tail.rfind(tag);
-  if (at == std::string::npos) throwBadInput(folder, fileName(file) + ": no pixel data");
-  uint64_t lengthAt = 0, dataAt = 0;
-  if (at + 8 <= tail.size() &&
-      (tail.compare(at + 4, 2, "OW") == 0 || tail.compare(at + 4, 2, "OB") == 0)) {
-    lengthAt = at + 8;
-    dataAt = at + 12;
-  } else {
-    lengthAt = at + 4;
-    dataAt = at + 8;
-  }
-  if (lengthAt + 4 > tail.size()) throwBadInput(folder, fileName(file) + ": truncated pixel data");
-  uint32_t length = 0;
-  std::memcpy(&length, tail.data() + lengthAt, 4);
-  if (length == 0xFFFFFFFFu)
-    throwBadInput(folder, fileName(file) + ": compressed (encapsulated) DICOM is not supported");
-  if (dataAt + length > size || length < minBytes)
-    throwBadInput(folder, fileName(file) + ": truncated pixel data (" + std::to_string(length) +
-                              " bytes declared, " + std::to_string(size - std::min(size, dataAt)) +
-                              " present)");
-}
 
 double dot(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -236,7 +204,6 @@ LoadedVolume readDicomSeries(const std::string& path, const ProgressCallback& pr
   const size_t perSlice = size_t(first.width) * size_t(first.height);
   std::shared_ptr<unsigned char[]> buffer;
   for (size_t s = 0; s < slices.size(); ++s) {
-    checkPixelData(path, slices[s].file, perSlice);
     vtkNew<vtkDICOMImageReader> reader;
     reader->SetFileName(slices[s].file.c_str());
     VtkImageRead read = runVtkImageReader(path + "/" + fileName(slices[s].file), reader, {});

@@ -346,7 +346,12 @@ bool plyTypeIsFloat(const std::string& t) {
 void validatePlyBody(const std::string& path, std::ifstream& in, uint64_t size, bool ascii,
                      bool bigEndian, const std::vector<PlyElement>& elements, long long vertices);
 
-void validatePlyHeader(const std::string& path, uint64_t size) {
+// The element counts a PLY header declares.
+struct PlyCounts {
+  long long vertices = -1, faces = -1;
+};
+
+PlyCounts validatePlyHeader(const std::string& path, uint64_t size) {
   static const char* const scalarTypes[] = {
       "char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
       "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
@@ -429,6 +434,7 @@ void validatePlyHeader(const std::string& path, uint64_t size) {
   if (faces < 0 || !indices)
     throwBadInput(path, "the PLY file has no face element with a vertex_indices list");
   validatePlyBody(path, in, size, ascii, bigEndian, elements, vertices);
+  return {vertices, faces};
 }
 
 void validatePlyBody(const std::string& path, std::ifstream& in, uint64_t size, bool ascii,
@@ -495,24 +501,6 @@ void validatePlyBody(const std::string& path, std::ifstream& in, uint64_t size, 
           }
         }
       }
-    }
-  }
-}
-
-// "element vertex N" / "element face M" from a PLY header (-1 when absent).
-void plyCounts(const std::string& path, long long& vertices, long long& faces) {
-  vertices = faces = -1;
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  for (int n = 0; n < 1000 && std::getline(in, line); ++n) {
-    std::istringstream s(line);
-    std::string word, element;
-    long long count = -1;
-    s >> word;
-    if (word == "end_header") break;
-    if (word == "element" && (s >> element >> count)) {
-      if (element == "vertex") vertices = count;
-      if (element == "face") faces = count;
     }
   }
 }
@@ -663,8 +651,9 @@ TriangleMesh repairAndCheck(const std::string& path, const std::vector<glm::vec3
 // PLY and STL through OpenMesh, after their structure was checked (validatePlyHeader walks a
 // PLY's body, validateStl a binary STL's size and values).
 PolygonSoup readWithOpenMesh(const std::string& path, uint64_t size, bool ply) {
+  PlyCounts declared;
   if (ply)
-    validatePlyHeader(path, size);
+    declared = validatePlyHeader(path, size);
   else
     validateStl(path, size);
   PolyMesh polyMesh;
@@ -715,14 +704,10 @@ PolygonSoup readWithOpenMesh(const std::string& path, uint64_t size, bool ply) {
   }
   // OpenMesh drops faces with a repeated vertex before they reach the mesh: degenerate too.
   soup.droppedFaces = countOccurrences(messages, "Face has equal vertices");
-  if (ply) {
-    long long declaredVertices = -1, declaredFaces = -1;
-    plyCounts(path, declaredVertices, declaredFaces);
-    if ((declaredVertices >= 0 && (long long)originalVertices < declaredVertices) ||
-        (declaredFaces >= 0 && (long long)(polyMesh.n_faces() + soup.droppedFaces) < declaredFaces))
-      throwBadInput(path, "truncated: the header declares " + std::to_string(declaredVertices) +
-                              " vertices and " + std::to_string(declaredFaces) + " faces");
-  }
+  if (ply && ((long long)originalVertices < declared.vertices ||
+              (long long)(polyMesh.n_faces() + soup.droppedFaces) < declared.faces))
+    throwBadInput(path, "truncated: the header declares " + std::to_string(declared.vertices) +
+                            " vertices and " + std::to_string(declared.faces) + " faces");
   return soup;
 }
 

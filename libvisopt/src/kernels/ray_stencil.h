@@ -35,7 +35,8 @@ VISOPT_HD VISOPT_INLINE float rayLoadAs(const float* data, ptrdiff_t i) {
   return data[i];
 }
 VISOPT_HD VISOPT_INLINE float rayLoadAs(const Half* data, ptrdiff_t i) {
-  return rayLoadHalf(data, size_t(i));
+  // i may be negative (a neighbour before data): offset the pointer, not a wrapped size_t index.
+  return rayLoadHalf(data + i, 0);
 }
 
 // The lower corner and fractional position of p's cell, p clamped to the grid as

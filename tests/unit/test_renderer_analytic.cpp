@@ -3,9 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include "render/renderer.h"
 #include "render_fixtures.h"
 #include "visopt/engine.h"
 #include "visopt/frustum.h"
+#include "visopt/scenes.h"
 
 using namespace visopt;
 using namespace visopt::testing;
@@ -122,3 +124,64 @@ TEST(Renderer, PreviewHasRequestedSizeAndFewerSamples) {
 
 INSTANTIATE_TEST_SUITE_P(Precisions, RendererPrecision,
                          ::testing::Values(Precision::FP32, Precision::FP16));
+
+// The volume's empty-space block ranges computed once (what the Engine keeps per volume) give the
+// image that building them for the frame gives, bit for bit, in both precisions; ranges of
+// another volume's size are not used.
+TEST(Renderer, BlockRangesKeptAcrossFramesGiveTheSameImage) {
+  for (Precision precision : {Precision::FP32, Precision::FP16}) {
+    BuiltinScene built = makeBuiltinScene("shepp-logan", 40, precision);
+    const Volume& volume = built.volume;
+    const TransferTable baked = built.transferFunction.bake(volume.valueMin, volume.valueMax,
+                                                            volume.grid().minSpacing(), 1024);
+    DeviceBuffer<glm::vec4> table(baked.albedoExtinction.size());
+    for (size_t i = 0; i < table.size(); ++i) table[i] = baked.albedoExtinction[i];
+    RenderScene scene;
+    scene.volume = &volume;
+    scene.transfer = &table;
+    scene.camera = Camera::orbitBounds(volume.grid().worldBounds(), 30.f, 20.f, 3.f);
+    scene.light = PointLight::keyLightFor(scene.camera, volume.grid().worldBounds());
+    RenderSettings settings;
+    settings.width = settings.height = 48;
+    const Image perFrame = renderImage(scene, settings, nullptr, {});
+    const DeviceBuffer<glm::vec2> ranges = computeVolumeBlockRange(volume);
+    scene.volumeBlockRange = &ranges;
+    const Image kept = renderImage(scene, settings, nullptr, {});
+    ASSERT_EQ(kept.pixels.size(), perFrame.pixels.size());
+    size_t lit = 0;
+    for (size_t i = 0; i < kept.pixels.size(); ++i) {
+      ASSERT_EQ(kept.pixels[i], perFrame.pixels[i]) << "pixel " << i << ", " << toString(precision);
+      lit += glm::length(perFrame.pixels[i] - settings.background) > 0.05f;
+    }
+    EXPECT_GT(lit, kept.pixels.size() / 10) << "the scene is not in the image";
+    // The kept ranges are what the frame uses: ranges saying every block holds only air (value
+    // 0, transparent in this transfer function) skip the whole volume.
+    DeviceBuffer<glm::vec2> air(ranges.size());
+    for (size_t i = 0; i < air.size(); ++i) air[i] = glm::vec2(0.f, 0.f);
+    scene.volumeBlockRange = &air;
+    EXPECT_NE(renderImage(scene, settings, nullptr, {}).pixels, perFrame.pixels);
+    // Ranges that do not fit the volume (another volume's) are not used.
+    DeviceBuffer<glm::vec2> other(ranges.size() + 1);
+    for (size_t i = 0; i < other.size(); ++i) other[i] = glm::vec2(0.f, 0.f);
+    scene.volumeBlockRange = &other;
+    EXPECT_EQ(renderImage(scene, settings, nullptr, {}).pixels, perFrame.pixels);
+  }
+}
+
+// The Engine keeps the block ranges per volume: a new volume of the same size gets its own (a
+// stale one would skip or keep the wrong blocks), as a fresh engine would draw it; the ranges
+// are in the ledger.
+TEST(Renderer, TheEngineRebuildsBlockRangesForANewVolume) {
+  RenderSettings settings;
+  settings.width = settings.height = 40;
+  Engine engine;
+  engine.loadBuiltinScene("shepp-logan", 32);
+  (void)engine.render(settings);
+  bool listed = false;
+  for (const auto& f : engine.ledger().entries()) listed = listed || f.name == "render-skip-ranges";
+  EXPECT_TRUE(listed);
+  engine.loadBuiltinScene("marschner-lobb", 32);
+  Engine fresh;
+  fresh.loadBuiltinScene("marschner-lobb", 32);
+  EXPECT_EQ(engine.render(settings).pixels, fresh.render(settings).pixels);
+}

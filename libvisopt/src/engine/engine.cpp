@@ -29,6 +29,10 @@ struct Engine::Impl {
   DeviceBuffer<glm::vec4> table;
   bool tableDirty = true;
   int tableToken = 0;
+  // The volume's empty-space block ranges, computed at its first render (a preview spent ~15 %
+  // of its time rebuilding them); dropped with the volume.
+  std::optional<DeviceBuffer<glm::vec2>> volumeBlockRange;
+  int volumeBlockRangeToken = 0;
   float tableMaxExtinction = 0.f;
   FrustumGrid lightFrustum;
   std::optional<Field3D> lightTransmittance;
@@ -59,6 +63,9 @@ struct Engine::Impl {
   explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
 
   void clearScene() {
+    volumeBlockRange.reset();
+    if (volumeBlockRangeToken) ledger.remove(volumeBlockRangeToken);
+    volumeBlockRangeToken = 0;
     optimizer.reset();
     importance.reset();
     importanceSource = {};
@@ -141,6 +148,7 @@ struct Engine::Impl {
     s.importanceBehind = optimizer.importanceBehind();
     s.importance = importance ? &*importance : nullptr;
     if (worldMaskWords) s.worldMask = worldMaskWords->view();
+    if (volumeBlockRange) s.volumeBlockRange = &*volumeBlockRange;
     if (lightTransmittance) {
       s.lightFrustum = &lightFrustum;
       s.lightTransmittance = &*lightTransmittance;
@@ -160,6 +168,12 @@ struct Engine::Impl {
         extinctionChange->precision() != precision)
       extinctionChange.emplace("extinction-change (render)", g, precision, &ledger);
     computeExtinctionChange(*volume, table, *mu, *extinctionChange);
+  }
+
+  void ensureVolumeBlockRange() {
+    if (volumeBlockRange) return;
+    volumeBlockRange.emplace(computeVolumeBlockRange(*volume));
+    volumeBlockRangeToken = ledger.add("render-skip-ranges", volumeBlockRange->bytes(), "fp32");
   }
 
   double ensureLight(const RenderSettings& settings) {
@@ -304,6 +318,7 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
     impl_->updateExtinctionChange(optimized);
   }
   double lightMs = impl_->ensureLight(settings);
+  impl_->ensureVolumeBlockRange();
   if (abandon && abandon()) return Image();
   Image image = renderImage(impl_->scene(optimized), settings, stats, abandon);
   if (stats) stats->lightMilliseconds = lightMs;

@@ -78,12 +78,16 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
   // The change is sampled at the volume's index coordinates: only a field on the volume's grid.
   if (scene.extinctionChange && scene.extinctionChange->grid().dims != scene.volume->grid().dims)
     return;
-  const FieldView scalars(scene.volume->normalized);
-  const glm::ivec3 blocks = raySkipBlocks(scalars.dims);
+  const glm::ivec3 blocks = raySkipBlocks(scene.volume->grid().dims);
   const int64_t n = int64_t(blocks.x) * blocks.y * blocks.z;
-  out.range = DeviceBuffer<glm::vec2>(size_t(n));
   out.empty = DeviceBuffer<uint8_t>(size_t(n));
-  exec::parallelFor("render skip ranges", n, RaySkipRange{scalars, blocks, out.range.data()});
+  const glm::vec2* range = nullptr;
+  if (scene.volumeBlockRange && scene.volumeBlockRange->size() == size_t(n)) {
+    range = scene.volumeBlockRange->data();  // the caller's, computed once per volume
+  } else {
+    out.range = computeVolumeBlockRange(*scene.volume);
+    range = out.range.data();
+  }
   if (scene.extinctionChange) {
     out.changeRange = DeviceBuffer<glm::vec2>(size_t(n));
     exec::parallelFor(
@@ -92,7 +96,7 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
     flags.changeRange = out.changeRange.data();
   }
   flags.blocks = blocks;
-  flags.range = out.range.data();
+  flags.range = range;
   flags.empty = out.empty.data();
   exec::parallelFor("render skip flags", n, flags);
   out.grid.empty = out.empty.data();
@@ -100,6 +104,15 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
 }
 
 }  // namespace
+
+DeviceBuffer<glm::vec2> computeVolumeBlockRange(const Volume& volume) {
+  const FieldView scalars(volume.normalized);
+  const glm::ivec3 blocks = raySkipBlocks(scalars.dims);
+  const int64_t n = int64_t(blocks.x) * blocks.y * blocks.z;
+  DeviceBuffer<glm::vec2> range(static_cast<size_t>(n));
+  exec::parallelFor("render skip ranges", n, RaySkipRange{scalars, blocks, range.data()});
+  return range;
+}
 
 void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
                              const Field3D& mu, Field3D& out) {

@@ -29,10 +29,10 @@ struct Engine::Impl {
   DeviceBuffer<glm::vec4> table;
   bool tableDirty = true;
   int tableToken = 0;
-  // The volume's empty-space block ranges, computed at its first render (a preview spent ~15 %
-  // of its time rebuilding them); dropped with the volume.
-  std::optional<DeviceBuffer<glm::vec2>> volumeBlockRange;
-  int volumeBlockRangeToken = 0;
+  // Empty-space block ranges of the volume (computed at its first render, dropped with it) and
+  // of the extinction change (computed with it): a preview spent ~15 % of its time on each.
+  std::optional<DeviceBuffer<glm::vec2>> volumeBlockRange, changeBlockRange;
+  int volumeBlockRangeToken = 0, changeBlockRangeToken = 0;
   float tableMaxExtinction = 0.f;
   FrustumGrid lightFrustum;
   std::optional<Field3D> lightTransmittance;
@@ -149,6 +149,7 @@ struct Engine::Impl {
     s.importance = importance ? &*importance : nullptr;
     if (worldMaskWords) s.worldMask = worldMaskWords->view();
     if (volumeBlockRange) s.volumeBlockRange = &*volumeBlockRange;
+    if (s.extinctionChange && changeBlockRange) s.changeBlockRange = &*changeBlockRange;
     if (lightTransmittance) {
       s.lightFrustum = &lightFrustum;
       s.lightTransmittance = &*lightTransmittance;
@@ -159,6 +160,9 @@ struct Engine::Impl {
   // Allocated only while an optimised mu is drawn.
   void updateExtinctionChange(bool optimized) {
     const Field3D* mu = optimizer.extinction();
+    changeBlockRange.reset();
+    if (changeBlockRangeToken) ledger.remove(changeBlockRangeToken);
+    changeBlockRangeToken = 0;
     if (!optimized || !renderOptimized || !mu) {
       extinctionChange.reset();
       return;
@@ -168,11 +172,14 @@ struct Engine::Impl {
         extinctionChange->precision() != precision)
       extinctionChange.emplace("extinction-change (render)", g, precision, &ledger);
     computeExtinctionChange(*volume, table, *mu, *extinctionChange);
+    changeBlockRange.emplace(computeBlockRange(*extinctionChange));
+    changeBlockRangeToken =
+        ledger.add("render-skip-ranges (change)", changeBlockRange->bytes(), "fp32");
   }
 
   void ensureVolumeBlockRange() {
     if (volumeBlockRange) return;
-    volumeBlockRange.emplace(computeVolumeBlockRange(*volume));
+    volumeBlockRange.emplace(computeBlockRange(volume->normalized));
     volumeBlockRangeToken = ledger.add("render-skip-ranges", volumeBlockRange->bytes(), "fp32");
   }
 

@@ -81,22 +81,17 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
   const glm::ivec3 blocks = raySkipBlocks(scene.volume->grid().dims);
   const int64_t n = int64_t(blocks.x) * blocks.y * blocks.z;
   out.empty = DeviceBuffer<uint8_t>(size_t(n));
-  const glm::vec2* range = nullptr;
-  if (scene.volumeBlockRange && scene.volumeBlockRange->size() == size_t(n)) {
-    range = scene.volumeBlockRange->data();  // the caller's, computed once per volume
-  } else {
-    out.range = computeVolumeBlockRange(*scene.volume);
-    range = out.range.data();
-  }
-  if (scene.extinctionChange) {
-    out.changeRange = DeviceBuffer<glm::vec2>(size_t(n));
-    exec::parallelFor(
-        "render skip ranges", n,
-        RaySkipRange{FieldView(*scene.extinctionChange), blocks, out.changeRange.data()});
-    flags.changeRange = out.changeRange.data();
-  }
+  // The caller's ranges when it kept them for these fields, else the frame's own.
+  auto ranges = [n](const DeviceBuffer<glm::vec2>* kept, const Field3D& field,
+                    DeviceBuffer<glm::vec2>& own) -> const glm::vec2* {
+    if (kept && kept->size() == size_t(n)) return kept->data();
+    own = computeBlockRange(field);
+    return own.data();
+  };
+  flags.range = ranges(scene.volumeBlockRange, scene.volume->normalized, out.range);
+  if (scene.extinctionChange)
+    flags.changeRange = ranges(scene.changeBlockRange, *scene.extinctionChange, out.changeRange);
   flags.blocks = blocks;
-  flags.range = range;
   flags.empty = out.empty.data();
   exec::parallelFor("render skip flags", n, flags);
   out.grid.empty = out.empty.data();
@@ -105,12 +100,12 @@ void buildSkipGrid(const RenderScene& scene, float step, SkipGridStorage& out) {
 
 }  // namespace
 
-DeviceBuffer<glm::vec2> computeVolumeBlockRange(const Volume& volume) {
-  const FieldView scalars(volume.normalized);
-  const glm::ivec3 blocks = raySkipBlocks(scalars.dims);
+DeviceBuffer<glm::vec2> computeBlockRange(const Field3D& field) {
+  const FieldView view(field);
+  const glm::ivec3 blocks = raySkipBlocks(view.dims);
   const int64_t n = int64_t(blocks.x) * blocks.y * blocks.z;
   DeviceBuffer<glm::vec2> range(static_cast<size_t>(n));
-  exec::parallelFor("render skip ranges", n, RaySkipRange{scalars, blocks, range.data()});
+  exec::parallelFor("render skip ranges", n, RaySkipRange{view, blocks, range.data()});
   return range;
 }
 

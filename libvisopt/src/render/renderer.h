@@ -35,14 +35,16 @@ struct RenderScene {
   const Field3D* importanceBehind = nullptr;
   const Field3D* importance = nullptr;
   BitMaskView worldMask;  // for the world-mask overlay; invalid without a mask
-  // The volume's per-block scalar ranges for empty-space skipping (computeVolumeBlockRange),
-  // kept by the caller while the volume stays the same; null: computed for every frame.
+  // Per-block ranges for empty-space skipping (computeBlockRange) of the volume's normalised
+  // scalars and of extinctionChange, kept by the caller while those fields stay the same; null:
+  // computed for the frame.
   const DeviceBuffer<glm::vec2>* volumeBlockRange = nullptr;
+  const DeviceBuffer<glm::vec2>* changeBlockRange = nullptr;
 };
 
-// The range of the volume's normalised scalars over each empty-space block
-// (kernels/ray_skip.h, pass 1): what a frame's skip grid needs of the volume alone.
-DeviceBuffer<glm::vec2> computeVolumeBlockRange(const Volume& volume);
+// The range of a field on the volume's grid over each empty-space block (kernels/ray_skip.h,
+// pass 1): what a frame's skip grid needs of the volume and of the extinction change.
+DeviceBuffer<glm::vec2> computeBlockRange(const Field3D& field);
 
 // out = mu - mu_bar on the volume's grid (out's grid), mu_bar from the baked transfer table at
 // each voxel's scalar, mu sampled trilinearly at the voxel's world position (so a coarse

@@ -390,15 +390,25 @@ TEST(Session, MovedDataIsFoundThroughTheRelativePath) {
   expectSameImage(engine.render(smallRender()), restored.render(smallRender()));
 }
 
+namespace {
+
+// An 8³ raw volume DIR/vol.raw and a session of it saved as DIR/s.json; returns the session's
+// path.
+std::string saveRawVolumeSession(const fs::path& dir) {
+  writeRawVolume(dir / "vol.raw", {8, 8, 8});
+  Engine engine;
+  engine.loadVolume((dir / "vol.raw").string());
+  const std::string path = (dir / "s.json").string();
+  saveSession(captureSession(engine, {}, path), path);
+  return path;
+}
+
+}  // namespace
+
 TEST(Session, MissingAndChangedDataAreReportedNotThrown) {
   const fs::path dir = freshDir("missing");
   const fs::path raw = dir / "vol.raw";
-  writeRawVolume(raw, {8, 8, 8});
-  Engine engine;
-  engine.loadVolume(raw.string());
-  const std::string path = (dir / "s.json").string();
-  Session s = captureSession(engine, {}, path);
-  saveSession(s, path);
+  const std::string path = saveRawVolumeSession(dir);
 
   // Changed: same place, other content; used, and reported.
   writeRawVolume(raw, {8, 8, 8}, 2.f);
@@ -441,11 +451,7 @@ TEST(Session, MissingAndChangedDataAreReportedNotThrown) {
 TEST(Session, DataIsMatchedBySizeFirstAndHashedLaterWithProgressAndCancel) {
   const fs::path dir = freshDir("lazy-hash");
   const fs::path raw = dir / "vol.raw";
-  writeRawVolume(raw, {8, 8, 8});
-  Engine engine;
-  engine.loadVolume(raw.string());
-  const std::string path = (dir / "s.json").string();
-  saveSession(captureSession(engine, {}, path), path);
+  const std::string path = saveRawVolumeSession(dir);
   const Session saved = loadSession(path);
 
   // Same size, other content: a size check cannot tell and reads nothing.

@@ -10,6 +10,8 @@
 // 1.5 thick), as in the paper's figures where the important structures are large.
 #include <cmath>
 
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -17,6 +19,7 @@
 
 #include "occluder_scene.h"
 #include "visopt/engine.h"
+#include "visopt/exec.h"
 
 using namespace visopt;
 using namespace visopt::testing;
@@ -25,6 +28,13 @@ namespace {
 
 constexpr int kN = 40;
 constexpr float kSphereRadius = 12.f, kShell = 0.75f;
+
+// Calls of the ghat gather (Eq. 19) so far in this process.
+long long importanceBehindGathers() {
+  for (const StageTiming& t : stageTimings())
+    if (t.name == "grid updates: importance behind") return t.calls;
+  return 0;
+}
 
 // A volume with only a thin disc (value 0.5, radius 9) facing the camera at the centre.
 Volume blobVolume(Precision p) {
@@ -160,8 +170,9 @@ TEST(ContextSurfaces, LensAndScreenMaskModulateTheImportanceAlongTheirRays) {
 
 // ghat (Eq. 19) depends on the importance, the frusta and the screen weights only, so a run
 // computes it once per level (ExtinctionOptimizer::Level::ghatFixed). The premise, checked on
-// the path that recomputes it every iteration: after 30 more iterations that opened the surface
-// and changed mu, ghat is bit for bit what a whole run kept from its first iteration.
+// a path that recomputes it every iteration (setting the same lens again counts as a change of
+// the screen weights): after 19 more iterations that opened the surface and changed mu, ghat is
+// bit for bit what a whole run kept from its first iteration.
 TEST(ContextSurfaces, TheImportanceBehindDoesNotChangeAsTheSurfaceOpens) {
   Engine kept;
   setup(kept);
@@ -177,7 +188,12 @@ TEST(ContextSurfaces, TheImportanceBehindDoesNotChangeAsTheSurfaceOpens) {
   const Field3D* phi = recomputed.contextSurfacePhi(0);
   std::vector<float> phiBefore(phi->size());
   for (size_t v = 0; v < phi->size(); ++v) phiBefore[v] = phi->get(v);
-  recomputed.continueOptimization(19);
+  const long long gathers = importanceBehindGathers();
+  for (int i = 0; i < 19; ++i) {
+    recomputed.setLens(recomputed.lens());
+    recomputed.continueOptimization(1);
+  }
+  EXPECT_EQ(importanceBehindGathers(), gathers + 19) << "recomputed every iteration";
   size_t moved = 0;
   const float h = recomputed.volume().grid().minSpacing();
   for (size_t v = 0; v < phi->size(); ++v)
@@ -218,6 +234,93 @@ void singleThreaded(F body) {
 }
 
 }  // namespace
+
+namespace {
+
+void runOneIteration(Engine& e) {
+  ExtinctionSettings s = e.extinctionSettings();
+  s.maxIterationsPerLevel = s.minIterationsPerLevel = 1;
+  e.setExtinctionSettings(s);
+  e.optimize();
+}
+
+}  // namespace
+
+// The workstation's path (Engine::continueOptimization, one iteration per call) keeps ghat while
+// the camera, the light, the importance and the screen weights stay as they are: the same mu and
+// phi, bit for bit, as recomputing it every iteration, without the gather. Each change of its
+// inputs gives at once the ghat a fresh engine computes for the changed scene.
+TEST(ContextSurfaces, TheContinuingPathKeepsTheImportanceBehindUntilItsInputsChange) {
+  singleThreaded([] {
+    Engine kept, recomputed;
+    for (Engine* e : {&kept, &recomputed}) {
+      setup(*e);
+      runOneIteration(*e);
+    }
+    const long long before = importanceBehindGathers();
+    for (int i = 0; i < 4; ++i) ASSERT_EQ(kept.continueOptimization(1).size(), 1u);
+    EXPECT_EQ(importanceBehindGathers(), before) << "ghat kept: no gather";
+    for (int i = 0; i < 4; ++i) {
+      recomputed.setLens(recomputed.lens());  // the same weights, counted as a change
+      ASSERT_EQ(recomputed.continueOptimization(1).size(), 1u);
+    }
+    EXPECT_EQ(importanceBehindGathers(), before + 4);
+    EXPECT_EQ(valuesOf(*kept.optimizedExtinction()), valuesOf(*recomputed.optimizedExtinction()));
+    EXPECT_EQ(valuesOf(*kept.contextSurfacePhi(0)), valuesOf(*recomputed.contextSurfacePhi(0)));
+  });
+
+  // Each input of ghat, changed on the continuing engine, against a fresh engine set up with the
+  // change (ghat does not depend on mu or phi, so one iteration of it gives the same field).
+  const std::vector<std::pair<const char*, std::function<void(Engine&)>>> changes = {
+      {"camera",
+       [](Engine& e) {
+         e.setCamera(Camera::orbit({0, 0, 0}, 40.f, 10.f, 90.f));
+       }},
+      {"light",
+       [](Engine& e) {
+         PointLight l = e.light();
+         l.position = {60.f, -60.f, 20.f};
+         e.setLight(l);
+       }},
+      {"lens",
+       [](Engine& e) {
+         ImportanceLens lens;
+         lens.x = 0.4f;
+         lens.y = 0.5f;
+         lens.radius = 0.2f;
+         lens.strength = 0.f;
+         e.setLens(lens);
+       }},
+      {"screen mask",
+       [](Engine& e) {
+         std::vector<float> w(8 * 8, 1.f);
+         for (int x = 0; x < 4; ++x)
+           for (int y = 0; y < 8; ++y) w[size_t(y * 8 + x)] = 0.f;
+         e.setScreenMask(w, 8, 8);
+       }},
+      {"importance",
+       [](Engine& e) {
+         e.setImportanceCurve({{0.0, 0.0}, {0.4, 0.0}, {0.5, 0.3}});
+       }},
+      {"viewport", [](Engine& e) { e.setViewportSize(40, 32); }},
+  };
+  for (const auto& [what, change] : changes) {
+    SCOPED_TRACE(what);
+    Engine continuing, fresh;
+    setup(continuing);
+    runOneIteration(continuing);
+    continuing.continueOptimization(2);
+    const std::vector<float> ghatBefore = valuesOf(*continuing.importanceBehind());
+    change(continuing);
+    ASSERT_EQ(continuing.continueOptimization(1).size(), 1u);
+    setup(fresh);
+    change(fresh);
+    runOneIteration(fresh);
+    const std::vector<float> ghat = valuesOf(*continuing.importanceBehind());
+    EXPECT_NE(ghat, ghatBefore) << "the change matters to ghat";
+    EXPECT_EQ(ghat, valuesOf(*fresh.importanceBehind()));
+  }
+}
 
 // What the workstation does when the camera moves mid-iteration (Engine::continueOptimization's
 // `abandon`): an iteration abandoned after its grid updates changes nothing, bit for bit: not

@@ -59,6 +59,9 @@ struct Engine::Impl {
   // The optimised mu as the renderer draws it (render/renderer.h), refreshed at each render.
   std::optional<Field3D> extinctionChange;
   int viewportWidth = 512, viewportHeight = 512;
+  // Counts the changes of what ghat (Eq. 19) reads besides the frusta: the importance and the
+  // screen weights (lens, windowing mask). The optimiser recomputes ghat when it changes.
+  uint64_t importanceRevision = 0;
 
   explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
 
@@ -75,6 +78,7 @@ struct Engine::Impl {
     worldMaskWords.reset();
     volume.reset();
     frozen = false;
+    ++importanceRevision;
   }
 
   OptimizationInputs optimizationInputs() {
@@ -98,6 +102,7 @@ struct Engine::Impl {
     in.worldMask = worldMaskWords ? &*worldMaskWords : nullptr;
     in.lens = lens;
     in.screenMask = screenMask ? &*screenMask : nullptr;
+    in.importanceRevision = importanceRevision;
     return in;
   }
 
@@ -467,6 +472,7 @@ void Engine::setLens(const ImportanceLens& lens) {
       lens.strength < 0.f || !std::isfinite(lens.x) || !std::isfinite(lens.y))
     throw Error(ErrorKind::Usage, "the lens needs a finite position, radius >= 0, strength >= 0");
   impl_->lens = lens;
+  ++impl_->importanceRevision;
 }
 const ImportanceLens& Engine::lens() const {
   return impl_->lens;
@@ -475,20 +481,21 @@ const ImportanceLens& Engine::lens() const {
 void Engine::setScreenMask(const std::vector<float>& weights, int width, int height) {
   if (width <= 0 || height <= 0 || weights.size() != size_t(width) * size_t(height))
     throw Error(ErrorKind::Usage, "a screen mask needs width x height weights");
+  for (const float w : weights)  // checked before anything changes: a bad mask keeps the old one
+    if (!std::isfinite(w) || w < 0.f || w > 1.f)
+      throw Error(ErrorKind::Usage, "screen-mask weights must lie in [0, 1]");
   GridSpec g;
   g.dims = glm::ivec3(width, height, 1);
   impl_->screenMask.reset();
   impl_->screenMask.emplace("screen-mask", g, Precision::FP32, &impl_->ledger);
-  for (size_t i = 0; i < weights.size(); ++i) {
-    const float w = weights[i];
-    if (!std::isfinite(w) || w < 0.f || w > 1.f)
-      throw Error(ErrorKind::Usage, "screen-mask weights must lie in [0, 1]");
-    impl_->screenMask->set(i, w);  // row 0 at the top, as ScreenWeights reads it
-  }
+  for (size_t i = 0; i < weights.size(); ++i)
+    impl_->screenMask->set(i, weights[i]);  // row 0 at the top, as ScreenWeights reads it
+  ++impl_->importanceRevision;
 }
 
 void Engine::clearScreenMask() {
   impl_->screenMask.reset();
+  ++impl_->importanceRevision;
 }
 
 const Field3D* Engine::importanceBehind() const {
@@ -501,6 +508,7 @@ void Engine::setImportanceCurve(const std::vector<glm::dvec2>& points, const std
   impl_->importance.emplace(
       importanceFromCurve(*impl_->volume, points, origin, impl_->precision, &impl_->ledger));
   impl_->importanceSource = {ImportanceSource::Kind::Curve, points, {}};
+  ++impl_->importanceRevision;
   // The optimisation continues from its current state with the new importance (warm start).
 }
 
@@ -514,6 +522,7 @@ void Engine::loadImportance(const std::string& path) {
   impl_->importance.reset();
   impl_->importance.emplace(std::move(g));
   impl_->importanceSource = {ImportanceSource::Kind::Volume, {}, path};
+  ++impl_->importanceRevision;
 }
 
 const Engine::ImportanceSource& Engine::importanceSource() const {

@@ -151,6 +151,28 @@ std::vector<float> analyticGradient(const ExtinctionProblem& p, Precision precis
 
 // ---- the optimiser ---------------------------------------------------------------------------
 
+namespace {
+
+// What ghat (Eq. 19) is computed from besides the level's grid: the frusta it gathers the maxima
+// of g along, and the revision of the importance and the screen weights.
+struct ImportanceBehindInputs {
+  FrustumGrid view, light;
+  uint64_t importanceRevision = 0;
+};
+
+bool sameFrustum(const FrustumGrid& a, const FrustumGrid& b) {
+  return a.eye == b.eye && a.right == b.right && a.up == b.up && a.forward == b.forward &&
+         a.tanHalfFovX == b.tanHalfFovX && a.tanHalfFovY == b.tanHalfFovY && a.dims == b.dims &&
+         a.sNear == b.sNear && a.sFar == b.sFar;
+}
+
+bool operator==(const ImportanceBehindInputs& a, const ImportanceBehindInputs& b) {
+  return sameFrustum(a.view, b.view) && sameFrustum(a.light, b.light) &&
+         a.importanceRevision == b.importanceRevision;
+}
+
+}  // namespace
+
 struct ExtinctionOptimizer::Level {
   int index = 0;
   bool finest = false;
@@ -178,10 +200,12 @@ struct ExtinctionOptimizer::Level {
   // iteration starts: a chunk costs the same whatever its length, so restarting each iteration
   // from `substeps` would double the steps of a level whose surfaces move slowly.
   int semiImplicitChunk = 0;
-  // Set by runMultigrid after the level's first iteration: ghat (Eq. 19) depends on the
-  // importance, the view and light frusta and the screen weights only, none of which changes
-  // within a run, so the frustum maxima of g and the importance-behind gather are not redone.
+  // ghat (Eq. 19) depends on the importance, the view and light frusta and the screen weights
+  // only: while they stay what `ghatFor` records (within a run, and between the workstation's
+  // iterations while the camera rests), the frustum maxima of g, the importance-behind gather
+  // and the fixed-brick marks are not redone.
   bool ghatFixed = false;
+  std::optional<ImportanceBehindInputs> ghatFor;  // what ghat was last computed for
   // The side of every surface each voxel lay on when this iteration's level-set steps began
   // (bit set: inside, phi < 0), 64 voxels per word.
   std::vector<DeviceBuffer<uint64_t>> insideAtStart;
@@ -481,6 +505,8 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
   IterationStats st;
   st.level = L.index;
   const bool hasSurfaces = !L.phi.empty();
+  const ImportanceBehindInputs ghatInputs{L.view, L.light, in.importanceRevision};
+  L.ghatFixed = L.ghatFor && *L.ghatFor == ghatInputs;
   const bool ghatNeeded = hasSurfaces && !L.ghatFixed;
   if (L.ghatFixed) {  // model only what the scene needs: the maxima are in ghat now
     L.viewMax.reset();
@@ -592,6 +618,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
   if (hasSurfaces) {
     L.substeps = levelSetSubsteps(in, s, L.grid, cap);
     surfaceStep(in, L, st);
+    L.ghatFor = ghatInputs;  // ghat now holds what these inputs give
   }
   return st;
 }
@@ -860,7 +887,6 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
       all.push_back(*done);
       if (callback && !callback(*done)) return all;
       if (cutShort_) return all;
-      level_->ghatFixed = true;
       // optimize/level_end.h: converged, or circling without progress.
       if (levelSettled(std::span(all).subspan(levelStart), s)) break;
     }
@@ -883,7 +909,6 @@ std::vector<IterationStats> ExtinctionOptimizer::iterate(const OptimizationInput
     buildLevel(in, s, 0, 1);  // start at the finest grid from mu_bar
   std::vector<IterationStats> all;
   for (int it = 0; it < iterations; ++it) {
-    level_->ghatFixed = false;  // the camera, light or importance may have changed meanwhile
     std::optional<IterationStats> st =
         runIteration(in, s, 1, std::max(iterations, s.maxIterationsPerLevel));
     if (!st) break;

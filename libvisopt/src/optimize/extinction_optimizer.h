@@ -36,6 +36,9 @@ struct OptimizationInputs {
   const DeviceBitMask* worldMask = nullptr;  // set: surfaces keep their base shape there
   ImportanceLens lens;
   const Field3D* screenMask = nullptr;  // width x height x 1 weights, row 0 at the top
+  // Changes (to any value) whenever `importance`, `lens` or `screenMask` change: ghat (Eq. 19)
+  // is kept from iteration to iteration while it and the frusta stay the same.
+  uint64_t importanceRevision = 0;
 };
 
 // Returning false from the callback stops the run after that iteration.

@@ -220,7 +220,7 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
     samples = exec::reduce("render", items, int64_t(0), kernel, sum);
   } else {
     // Bands of whole ray tiles, so that a newer camera need not wait for the whole frame.
-    constexpr int64_t kBands = 8;
+    constexpr int64_t kBands = 32;
     const int64_t tile = int64_t(kRayTile) * kRayTile;
     const int64_t band = (items / tile + kBands - 1) / kBands * tile;
     for (int64_t first = 0; first < items; first += band) {

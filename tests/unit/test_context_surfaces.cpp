@@ -376,3 +376,35 @@ TEST(ContextSurfaces, AnIterationAskedToStopDuringTheSurfaceStepEndsEarly) {
   EXPECT_LT(cut[0].levelSetSubsteps, full.back().levelSetSubsteps);
   EXPECT_EQ(e.continueOptimization(1).size(), 1u) << "and the optimisation carries on";
 }
+
+// A full frame gives way to a newer camera also while it computes the light transmittance T_L
+// (Engine::render's `abandon`, polled between bands of light rays). The preview that answers the
+// camera draws with the T_L at hand without computing it, and the next full frame computes it
+// whole: bit for bit the frame of a twin engine that never gave way.
+TEST(ContextSurfaces, AFullFrameGivesWayWhileItComputesTheLightTransmittance) {
+  singleThreaded([] {
+    RenderSettings full;
+    full.width = full.height = 48;
+    Engine a, twin;
+    for (Engine* e : {&a, &twin}) {
+      setup(*e);
+      runOneIteration(*e);
+      ASSERT_GT(e->render(full).width, 0);
+      ASSERT_EQ(e->continueOptimization(1).size(), 1u);  // mu changed: T_L is of an earlier mu
+    }
+    int polls = 0;
+    // The third poll is the one before the third band of light rays: two bands are new.
+    const Image gaveWay = a.render(full, nullptr, [&] { return ++polls == 3; });
+    EXPECT_EQ(gaveWay.width, 0);
+    EXPECT_EQ(polls, 3);
+    RenderSettings preview = full;
+    preview.preview = true;
+    preview.previewFactor = 2;
+    RenderStats stats;
+    EXPECT_EQ(a.render(preview, &stats).width, 48);
+    EXPECT_EQ(stats.lightMilliseconds, 0.0) << "the preview used the T_L at hand";
+    const Image mine = a.render(full, &stats);
+    EXPECT_GT(stats.lightMilliseconds, 0.0) << "the full frame computed T_L again";
+    EXPECT_EQ(mine.pixels, twin.render(full).pixels);
+  });
+}

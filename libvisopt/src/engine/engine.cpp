@@ -40,6 +40,10 @@ struct Engine::Impl {
   // The optimisation changed mu since T_L and the extinction change were computed: a full frame
   // recomputes both, a preview reuses them (render()).
   bool muChanged = false;
+  // T_L holds the light's transmittance through an earlier mu (or, after a full frame that gave
+  // way to a newer camera, partly through it): a full frame recomputes it, a preview may use it
+  // (lightDirty, by contrast, means the light, the transfer function or the scene changed).
+  bool lightFromOlderMu = false;
   bool lightOptimized = true;  // T_L was computed for the optimised scene
   int lightGridSize = 0, lightGridDepth = -1;
 
@@ -188,10 +192,17 @@ struct Engine::Impl {
     volumeBlockRangeToken = ledger.add("render-skip-ranges", volumeBlockRange->bytes(), "fp32");
   }
 
-  double ensureLight(const RenderSettings& settings) {
-    if (!lightDirty && settings.lightGridSize == lightGridSize &&
-        settings.lightGridDepth == lightGridDepth && lightTransmittance)
-      return 0.0;
+  // T_L for these settings; false when `abandon` stopped it (lightDirty / lightFromOlderMu then
+  // stay set, so the next full frame computes it again).
+  bool ensureLight(const RenderSettings& settings, const std::function<bool()>& abandon,
+                   double& ms) {
+    ms = 0.0;
+    const bool sameGrid = settings.lightGridSize == lightGridSize &&
+                          settings.lightGridDepth == lightGridDepth && lightTransmittance;
+    if (!lightDirty && sameGrid && (!lightFromOlderMu || settings.preview)) return true;
+    // Only mu changed: T_L given up part way (new on some rays, of an earlier mu on the others)
+    // still serves a preview. Anything else given up part way must be computed again.
+    const bool onlyOlderMu = !lightDirty && sameGrid;
     auto start = std::chrono::steady_clock::now();
     const GridSpec& g = volume->grid();
     // One depth cell per smallest voxel spacing unless asked otherwise.
@@ -203,12 +214,17 @@ struct Engine::Impl {
     lg.dims = lightFrustum.dims;
     if (!lightTransmittance || lightTransmittance->grid().dims != lg.dims)
       lightTransmittance.emplace("light-transmittance", lg, precision, &ledger);
-    computeLightTransmittance(scene(lightOptimized), lightFrustum, *lightTransmittance);
+    const bool done =
+        computeLightTransmittance(scene(lightOptimized), lightFrustum, *lightTransmittance, abandon);
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (!done) {
+      if (!onlyOlderMu) lightDirty = true;
+      return false;
+    }
     lightGridSize = settings.lightGridSize;
     lightGridDepth = settings.lightGridDepth;
-    lightDirty = false;
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-        .count();
+    lightDirty = lightFromOlderMu = false;
+    return true;
   }
 };
 
@@ -325,11 +341,14 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
                      impl_->lightTransmittance &&
                      (!optimized || !impl_->renderOptimized || impl_->extinctionChange);
   if (!reuse) {
-    if (impl_->muChanged) impl_->lightDirty = true;
+    if (impl_->muChanged) impl_->lightFromOlderMu = true;
     impl_->muChanged = false;
     impl_->updateExtinctionChange(optimized);
   }
-  double lightMs = impl_->ensureLight(settings);
+  // A full frame's T_L gives way to a newer camera too: the preview that answers it draws with
+  // the T_L of an earlier mu (lightFromOlderMu), the next full frame computes it whole.
+  double lightMs = 0.0;
+  if (!impl_->ensureLight(settings, abandon, lightMs)) return Image();
   impl_->ensureVolumeBlockRange();
   if (abandon && abandon()) return Image();
   Image image = renderImage(impl_->scene(optimized), settings, stats, abandon);

@@ -129,8 +129,8 @@ void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>
   });
 }
 
-void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
-                               Field3D& out) {
+bool computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
+                               Field3D& out, const std::function<bool()>& abandon) {
   if (out.grid().dims != lightFrustum.dims)
     throw Error(ErrorKind::Failure, "light transmittance field does not match its frustum");
   TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum),
@@ -141,8 +141,20 @@ void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
                                            {}};
   for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i)
     scan.surfaces.phi[scan.surfaces.count++] = FieldView(*scene.surfaces[i]);
-  exec::parallelFor("light transmittance", int64_t(lightFrustum.dims.x) * lightFrustum.dims.y,
-                    scan);
+  const int64_t rays = int64_t(lightFrustum.dims.x) * lightFrustum.dims.y;
+  if (!abandon) {
+    exec::parallelFor("light transmittance", rays, scan);
+    return true;
+  }
+  // Bands of rays, so that a newer camera need not wait for the whole grid.
+  constexpr int64_t kBands = 16;
+  const int64_t band = (rays + kBands - 1) / kBands;
+  for (int64_t first = 0; first < rays; first += band) {
+    if (abandon()) return false;
+    exec::parallelFor("light transmittance", std::min(band, rays - first),
+                      [=] VISOPT_HD(int64_t ray) { scan(first + ray); });
+  }
+  return true;
 }
 
 Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,

@@ -53,8 +53,11 @@ void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>
                              const Field3D& mu, Field3D& out);
 
 // T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h).
-void computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
-                               Field3D& out);
+// `abandon` (may be empty) is polled between bands of light rays: when it returns true the
+// computation stops and returns false, and `out` holds the new T_L on the bands done and what it
+// held before on the others.
+bool computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
+                               Field3D& out, const std::function<bool()>& abandon = {});
 
 // `abandon` (may be empty) is polled between bands of the image; when it returns true the render
 // stops and returns an empty (0 x 0) image. `settings` must have passed checkRenderSettings

@@ -214,9 +214,10 @@ struct Engine::Impl {
     lg.dims = lightFrustum.dims;
     if (!lightTransmittance || lightTransmittance->grid().dims != lg.dims)
       lightTransmittance.emplace("light-transmittance", lg, precision, &ledger);
-    const bool done =
-        computeLightTransmittance(scene(lightOptimized), lightFrustum, *lightTransmittance, abandon);
-    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const bool done = computeLightTransmittance(scene(lightOptimized), lightFrustum,
+                                                *lightTransmittance, abandon);
+    ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!done) {
       if (!onlyOlderMu) lightDirty = true;
       return false;

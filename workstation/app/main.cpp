@@ -29,7 +29,10 @@ namespace {
 // pause in which the optimisation resumes, so every drag meets an iteration in flight. Then one
 // continuous 3-second drag (previews on screen per second) and its release (the time to the first
 // full-resolution frame of the resting view, and until that view has converged).
-int runLatencyProbe(MainWindow& window, int steps) {
+// With `framesDir`, the continuous drag's first preview, one a second after it and the first full
+// frame of the resting view are saved there as drag-preview-N.png and rest-full.png, to be looked
+// at.
+int runLatencyProbe(MainWindow& window, int steps, const QString& framesDir) {
   ViewportWidget* view = window.viewport();
   const auto pump = [](int ms) {
     QElapsedTimer t;
@@ -52,8 +55,13 @@ int runLatencyProbe(MainWindow& window, int steps) {
   // A continuous drag, as a hand does it: a small orbit every 16 ms (a 60 Hz mouse) for 3 s;
   // how many previews reach the screen per second.
   int previews = 0;
-  const QMetaObject::Connection counting = QObject::connect(
-      view, &ViewportWidget::frameShown, [&](const FrameInfo& info) { previews += info.preview; });
+  const QMetaObject::Connection counting =
+      QObject::connect(view, &ViewportWidget::frameShown, [&](const FrameInfo& info) {
+        if (!info.preview) return;
+        if (!framesDir.isEmpty() && (previews == 0 || previews == 10))
+          view->frame().save(framesDir + QStringLiteral("/drag-preview-%1.png").arg(previews));
+        ++previews;
+      });
   QElapsedTimer drag;
   drag.start();
   while (drag.elapsed() < 3000) {
@@ -70,7 +78,11 @@ int runLatencyProbe(MainWindow& window, int steps) {
   double restToFullFrameMs = -1.0;  // the first full-resolution frame of the resting view
   const QMetaObject::Connection full =
       QObject::connect(view, &ViewportWidget::frameShown, [&](const FrameInfo& info) {
-        if (!info.preview && restToFullFrameMs < 0.0) restToFullFrameMs = double(rest.elapsed());
+        if (!info.preview && restToFullFrameMs < 0.0) {
+          restToFullFrameMs = double(rest.elapsed());
+          if (!framesDir.isEmpty())
+            view->frame().save(framesDir + QStringLiteral("/rest-full.png"));
+        }
       });
   const bool settled = window.waitForSettledFrame(300000);
   QObject::disconnect(full);
@@ -123,6 +135,10 @@ int main(int argc, char** argv) {
                              QStringLiteral("Drag the camera N times while optimising, print "
                                             "the drag-to-preview latency as JSON and quit."),
                              QStringLiteral("N"));
+  QCommandLineOption probeFrames(QStringLiteral("probe-frames"),
+                                 QStringLiteral("With --latency-probe: save frames of the drag and "
+                                                "of the resting view in DIR."),
+                                 QStringLiteral("DIR"));
   QCommandLineOption stateDir(QStringLiteral("state-dir"),
                               QStringLiteral("Folder for autosave and recent sessions."),
                               QStringLiteral("DIR"));
@@ -139,7 +155,7 @@ int main(int argc, char** argv) {
                          QStringLiteral("Bring the dock panel with this title to the front."),
                          QStringLiteral("TITLE"));
   parser.addOptions({scene, volume, session, resolution, screenshot, windowShot, size, noOptimize,
-                     latency, stateDir, timeout, saveTo, deviation, tab});
+                     latency, probeFrames, stateDir, timeout, saveTo, deviation, tab});
   parser.addPositionalArgument(
       QStringLiteral("files"),
       QStringLiteral("A volume file or DICOM folder, or a session (.visopt-session, .json), to "
@@ -213,7 +229,8 @@ int main(int argc, char** argv) {
   }
   if (failures > 0) return 1;
   int rc = 0;
-  if (parser.isSet(latency)) rc = runLatencyProbe(window, parser.value(latency).toInt());
+  if (parser.isSet(latency))
+    rc = runLatencyProbe(window, parser.value(latency).toInt(), parser.value(probeFrames));
   if (parser.isSet(screenshot) && !window.exportViewport(parser.value(screenshot))) rc = 1;
   if (parser.isSet(windowShot)) {
     QApplication::processEvents();

@@ -17,6 +17,15 @@
 #include <immintrin.h>
 #define VISOPT_HOST_F16C 1
 #endif
+#elif defined(__clang__) && __clang_major__ < 15 && (defined(__x86_64__) || defined(__i386__))
+// clang before 15 accepts _Float16 on x86 only with AVX512-FP16 (the sanitizer and fuzz builds
+// use clang 14): convert with the F16C intrinsics there, the same instruction g++ emits.
+#if defined(__F16C__)
+#include <immintrin.h>
+#define VISOPT_HOST_F16C 1
+#else
+#error "visopt: clang < 15 on x86 needs F16C for fp16 fields (build with -march=native)"
+#endif
 #endif
 
 namespace visopt {
@@ -43,7 +52,9 @@ VISOPT_HD inline float halfToFloat(Half h) {
 // storing normalised or bounded quantities only.
 VISOPT_HD inline Half floatToHalf(float v) {
 #if defined(VISOPT_HOST_F16C) && !defined(__CUDA_ARCH__)
-  return Half{static_cast<uint16_t>(_cvtss_sh(v, _MM_FROUND_TO_NEAREST_INT))};
+  // _mm_cvtps_ph rather than _cvtss_sh, whose clang macro is a compound literal (-Wpedantic).
+  const __m128i h = _mm_cvtps_ph(_mm_set_ss(v), _MM_FROUND_TO_NEAREST_INT);
+  return Half{static_cast<uint16_t>(_mm_cvtsi128_si32(h) & 0xffff)};
 #elif defined(__CUDACC__)
   __half_raw raw = __half_raw(__float2half_rn(v));
   return Half{raw.x};

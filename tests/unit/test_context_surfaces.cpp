@@ -169,7 +169,7 @@ TEST(ContextSurfaces, LensAndScreenMaskModulateTheImportanceAlongTheirRays) {
 }
 
 // ghat (Eq. 19) depends on the importance, the frusta and the screen weights only, so a run
-// computes it once per level (ExtinctionOptimizer::Level::ghatFixed). The premise, checked on
+// computes it once per level (ExtinctionOptimizer::Level::ghatFor). The premise, checked on
 // a path that recomputes it every iteration (setting the same lens again counts as a change of
 // the screen weights): after 19 more iterations that opened the surface and changed mu, ghat is
 // bit for bit what a whole run kept from its first iteration.

@@ -204,7 +204,6 @@ struct ExtinctionOptimizer::Level {
   // only: while they stay what `ghatFor` records (within a run, and between the workstation's
   // iterations while the camera rests), the frustum maxima of g, the importance-behind gather
   // and the fixed-brick marks are not redone.
-  bool ghatFixed = false;
   std::optional<ImportanceBehindInputs> ghatFor;  // what ghat was last computed for
   // The side of every surface each voxel lay on when this iteration's level-set steps began
   // (bit set: inside, phi < 0), 64 voxels per word.
@@ -506,9 +505,9 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
   st.level = L.index;
   const bool hasSurfaces = !L.phi.empty();
   const ImportanceBehindInputs ghatInputs{L.view, L.light, in.importanceRevision};
-  L.ghatFixed = L.ghatFor && *L.ghatFor == ghatInputs;
-  const bool ghatNeeded = hasSurfaces && !L.ghatFixed;
-  if (L.ghatFixed) {  // model only what the scene needs: the maxima are in ghat now
+  const bool ghatKept = L.ghatFor && *L.ghatFor == ghatInputs;
+  const bool ghatNeeded = hasSurfaces && !ghatKept;
+  if (ghatKept) {  // model only what the scene needs: the maxima are in ghat now
     L.viewMax.reset();
     L.lightMax.reset();
   }
@@ -617,7 +616,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(const Optimizati
   st.stepNorm = std::sqrt(sums.step2 / double(L.grid.voxelCount()));
   if (hasSurfaces) {
     L.substeps = levelSetSubsteps(in, s, L.grid, cap);
-    surfaceStep(in, L, st);
+    surfaceStep(in, L, ghatKept, st);
     L.ghatFor = ghatInputs;  // ghat now holds what these inputs give
   }
   return st;
@@ -659,7 +658,8 @@ int64_t crossedSince(const Field3D& phi, const DeviceBuffer<uint64_t>& bits) {
 
 }  // namespace
 
-void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, IterationStats& st) {
+void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, bool ghatKept,
+                                      IterationStats& st) {
   // ghat (Eq. 19): half the max importance behind x along the view ray, half along the light
   // ray (the light grids exist whenever there are surfaces).
   auto t0 = Clock::now();
@@ -671,7 +671,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   if (L.viewMax) behind.viewMax = FrustumFieldView(*L.viewMax, L.view.dims);
   if (L.lightMax) behind.lightMax = FrustumFieldView(*L.lightMax, L.light.dims);
   behind.weights = screenWeightsOf(in);
-  if (!L.ghatFixed) {
+  if (!ghatKept) {
     if (activeBackend() == Backend::CPU) {
       importanceBehindOnHost("grid updates: importance behind", behind);
     } else {
@@ -686,7 +686,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, It
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   // The bricks of each band that this ghat leaves as they are (narrow_band.h), once per ghat.
   for (size_t si = 0; si < L.phi.size(); ++si)
-    if (!L.ghatFixed || !L.bands[si].fixedFor(*L.ghat))
+    if (!ghatKept || !L.bands[si].fixedFor(*L.ghat))
       markFixedBricks(L.phi[si], L.finest ? *in.surfaceBases[si] : L.phi0[si], *L.ghat, in.levelSet,
                       L.bands[si]);
   st.sdfStepMs = msSince(t0);

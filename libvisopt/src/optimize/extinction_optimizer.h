@@ -108,7 +108,9 @@ class ExtinctionOptimizer {
   std::optional<IterationStats> runIteration(const OptimizationInputs& in,
                                              const ExtinctionSettings& settings, int levels,
                                              int cap);
-  void surfaceStep(const OptimizationInputs& in, Level& level, IterationStats& stats);
+  // `ghatKept`: ghat already holds what this iteration's inputs give (Level::ghatFor).
+  void surfaceStep(const OptimizationInputs& in, Level& level, bool ghatKept,
+                   IterationStats& stats);
 
  private:
   bool abandonRequested() const { return abandon_ && *abandon_ && (*abandon_)(); }

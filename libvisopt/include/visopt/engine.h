@@ -11,6 +11,7 @@
 
 #include "visopt/bit_mask.h"
 #include "visopt/camera.h"
+#include "visopt/clearview.h"
 #include "visopt/context_surface.h"
 #include "visopt/exec.h"
 #include "visopt/image.h"
@@ -152,6 +153,14 @@ class Engine {
   // stops and returns an empty (0 x 0) image, for an interface whose camera moved meanwhile.
   Image render(const RenderSettings& settings, RenderStats* stats = nullptr,
                const std::function<bool()>& abandon = {});
+
+  // ---- ClearView (Krüger, Schneider, Westermann 2006; visopt/clearview.h) ----
+  // Renders the context-preserving hotspot for the current camera. The layers are extracted
+  // again only when the camera, the image size, the layers' sources, the volume, the transfer
+  // function or the context surfaces changed since the last call; otherwise only the
+  // compositing runs (stats->extracted says which). Usage error for settings that fail
+  // checkClearViewSettings or name a context surface or importance the scene lacks.
+  Image renderClearView(const ClearViewSettings& settings, ClearViewStats* stats = nullptr);
 
   const MemoryLedger& ledger() const;
 

@@ -6,6 +6,7 @@
 
 #include "core/device_bit_mask.h"
 #include "core/device_buffer.h"
+#include "engine/clearview_cache.h"
 #include "engine/context_surfaces.h"
 #include "engine/importance.h"
 #include "optimize/extinction_optimizer.h"
@@ -66,6 +67,10 @@ struct Engine::Impl {
   // Counts the changes of what ghat (Eq. 19) reads besides the frusta: the importance and the
   // screen weights (lens, windowing mask). The optimiser recomputes ghat when it changes.
   uint64_t importanceRevision = 0;
+  // Counts the changes of the volume, the transfer function and the context surfaces (also the
+  // optimisation's moves): ClearView extracts its layers again when it changes.
+  uint64_t sceneRevision = 0;
+  std::unique_ptr<ClearViewCache> clearView;
 
   explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
 
@@ -83,6 +88,8 @@ struct Engine::Impl {
     volume.reset();
     frozen = false;
     ++importanceRevision;
+    ++sceneRevision;
+    clearView.reset();
   }
 
   OptimizationInputs optimizationInputs() {
@@ -286,6 +293,7 @@ void Engine::setTransferFunction(TransferFunction tf) {
   impl_->tf = std::move(tf);
   impl_->hasTf = true;
   impl_->tableDirty = true;  // mu_bar changes; the optimisation continues from its current mu
+  ++impl_->sceneRevision;
 }
 
 const TransferFunction& Engine::transferFunction() const {
@@ -357,6 +365,60 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
   return image;
 }
 
+Image Engine::renderClearView(const ClearViewSettings& settings, ClearViewStats* stats) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
+  checkClearViewSettings(settings);
+  const Volume& volume = *impl_->volume;
+  const Bounds bounds = volume.grid().worldBounds();
+  checkCamera(impl_->camera, bounds);
+  checkLight(impl_->light, bounds);
+  impl_->ensureTable();
+  const auto source = [&](const ClearViewLayer& layer, const char* role) {
+    ClearViewSurfaceSource s;
+    const std::string r = role;
+    switch (layer.kind) {
+      case ClearViewLayerKind::Isosurface:
+        if (!(layer.isovalue > volume.valueMin && layer.isovalue < volume.valueMax))
+          throw Error(ErrorKind::Usage,
+                      "ClearView: the " + r + " isovalue " + std::to_string(layer.isovalue) +
+                          " lies outside the data's range (" + std::to_string(volume.valueMin) +
+                          ", " + std::to_string(volume.valueMax) + ")");
+        s.field = &volume.normalized;
+        s.iso = volume.toNormalized(layer.isovalue);
+        break;
+      case ClearViewLayerKind::ContextSurface:
+        if (layer.surface >= int(impl_->surfaceBases.size()))
+          throw Error(ErrorKind::Usage, "ClearView: the " + r + " layer names context surface " +
+                                            std::to_string(layer.surface) + ", the scene has " +
+                                            std::to_string(impl_->surfaceBases.size()));
+        // The surface as the renderer draws it: optimised when that is what is shown.
+        s.field = impl_->renderOptimized ? contextSurfacePhi(layer.surface)
+                                         : &impl_->surfaceBases[size_t(layer.surface)];
+        s.sign = -1.f;  // inside negative
+        break;
+      case ClearViewLayerKind::Importance:
+        if (!impl_->importance)
+          throw Error(ErrorKind::Usage, "ClearView: the " + r + " layer needs an importance");
+        s.field = &*impl_->importance;
+        s.iso = float(layer.isovalue);
+        break;
+    }
+    return s;
+  };
+  ClearViewInputs in;
+  in.volume = &volume;
+  in.transfer = &impl_->table;
+  in.transferToken = impl_->tableToken;
+  in.camera = impl_->camera;
+  in.light = impl_->light;
+  in.context = source(settings.context, "context");
+  in.focus = source(settings.focus, "focus");
+  in.sceneRevision = impl_->sceneRevision;
+  in.importanceRevision = impl_->importanceRevision;
+  if (!impl_->clearView) impl_->clearView = std::make_unique<ClearViewCache>(&impl_->ledger);
+  return impl_->clearView->render(in, settings, stats);
+}
+
 const MemoryLedger& Engine::ledger() const {
   return impl_->ledger;
 }
@@ -370,6 +432,7 @@ int Engine::addContextSurface(const ContextSurfaceSpec& spec, const ProgressCall
   impl_->surfaceSpecs.push_back(spec);
   impl_->optimizer.reset();
   impl_->lightDirty = true;
+  ++impl_->sceneRevision;
   return int(impl_->surfaceSpecs.size()) - 1;
 }
 
@@ -385,6 +448,7 @@ int Engine::addContextSurface(const ContextSurfaceSpec& spec, const Field3D& bas
   impl_->surfaceSpecs.push_back(spec);
   impl_->optimizer.reset();
   impl_->lightDirty = true;
+  ++impl_->sceneRevision;
   return int(impl_->surfaceSpecs.size()) - 1;
 }
 
@@ -393,6 +457,7 @@ void Engine::clearContextSurfaces() {
   impl_->surfaceBases.clear();
   impl_->optimizer.reset();
   impl_->lightDirty = true;
+  ++impl_->sceneRevision;
 }
 
 void Engine::removeContextSurface(int index) {
@@ -402,6 +467,7 @@ void Engine::removeContextSurface(int index) {
   impl_->surfaceBases.erase(impl_->surfaceBases.begin() + index);
   impl_->optimizer.reset();
   impl_->lightDirty = true;
+  ++impl_->sceneRevision;
 }
 
 void Engine::setContextSurfaceColor(int index, glm::vec3 rgb) {
@@ -579,11 +645,13 @@ std::vector<IterationStats> Engine::optimize(
   // Every iteration changes mu, also for a frame the callback renders.
   const auto noted = [&](const IterationStats& st) {
     impl_->muChanged = true;
+    ++impl_->sceneRevision;
     return !callback || callback(st);
   };
   auto stats = impl_->optimizer.runMultigrid(impl_->optimizationInputs(), impl_->extinctionSettings,
                                              noted, abandon);
   impl_->muChanged = true;
+  ++impl_->sceneRevision;
   return stats;
 }
 
@@ -593,11 +661,15 @@ std::vector<IterationStats> Engine::continueOptimization(
   if (impl_->frozen || iterations <= 0) return {};
   const auto noted = [&](const IterationStats& st) {
     impl_->muChanged = true;
+    ++impl_->sceneRevision;
     return !callback || callback(st);
   };
   auto stats = impl_->optimizer.iterate(impl_->optimizationInputs(), impl_->extinctionSettings,
                                         iterations, noted, abandon);
-  if (!stats.empty()) impl_->muChanged = true;
+  if (!stats.empty()) {
+    impl_->muChanged = true;
+    ++impl_->sceneRevision;
+  }
   return stats;
 }
 
@@ -611,6 +683,7 @@ bool Engine::frozen() const {
 void Engine::resetOptimization() {
   impl_->optimizer.reset();
   impl_->lightDirty = true;
+  ++impl_->sceneRevision;
 }
 
 bool Engine::hasOptimizedExtinction() const {
@@ -621,7 +694,10 @@ const Field3D* Engine::optimizedExtinction() const {
 }
 
 void Engine::setRenderOptimized(bool useOptimized) {
-  if (impl_->renderOptimized != useOptimized) impl_->lightDirty = true;
+  if (impl_->renderOptimized != useOptimized) {
+    impl_->lightDirty = true;
+    ++impl_->sceneRevision;
+  }
   impl_->renderOptimized = useOptimized;
 }
 bool Engine::renderOptimized() const {

@@ -1,0 +1,70 @@
+#include "engine/clearview_cache.h"
+
+#include <chrono>
+
+#include <glm/glm.hpp>
+
+namespace visopt {
+
+namespace {
+
+bool sameCamera(const Camera& a, const Camera& b) {
+  return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fovYDegrees == b.fovYDegrees;
+}
+
+}  // namespace
+
+bool ClearViewCache::Key::operator==(const Key& o) const {
+  return sameCamera(camera, o.camera) && width == o.width && height == o.height &&
+         context == o.context && focus == o.focus && volumeLayer == o.volumeLayer &&
+         volumeData == o.volumeData && contextField == o.contextField &&
+         focusField == o.focusField && transferToken == o.transferToken &&
+         sceneRevision == o.sceneRevision && importanceRevision == o.importanceRevision;
+}
+
+ClearViewCache::~ClearViewCache() {
+  if (ledgerToken_ && ledger_) ledger_->remove(ledgerToken_);
+}
+
+Image ClearViewCache::render(const ClearViewInputs& in, const ClearViewSettings& settings,
+                             ClearViewStats* stats) {
+  Key key;
+  key.camera = in.camera;
+  key.width = settings.width;
+  key.height = settings.height;
+  key.context = settings.context;
+  key.focus = settings.focus;
+  key.volumeLayer = settings.volumeLayer;
+  key.volumeData = in.volume->normalized.raw();
+  key.contextField = in.context.field ? in.context.field->raw() : nullptr;
+  key.focusField = in.focus.field ? in.focus.field->raw() : nullptr;
+  key.transferToken = in.transferToken;
+  key.sceneRevision = in.sceneRevision;
+  key.importanceRevision = in.importanceRevision;
+
+  ClearViewStats local;
+  ClearViewStats& st = stats ? *stats : local;
+  st = ClearViewStats{};
+  if (!key_ || !(*key_ == key)) {
+    const auto start = std::chrono::steady_clock::now();
+    key_.reset();  // a failed extraction leaves no layers that claim to be current
+    extractClearViewLayers(*in.volume, *in.transfer, in.camera, settings.width, settings.height,
+                           in.context, in.focus, settings.volumeLayer, layers_);
+    key_ = key;
+    ++extractions_;
+    st.extracted = true;
+    st.extractMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (ledger_) {
+      if (ledgerToken_) ledger_->remove(ledgerToken_);
+      ledgerToken_ = ledger_->add("clearview-layers", layers_.bytes(), "fp32");
+    }
+  }
+  const Bounds b = in.volume->grid().worldBounds();
+  const float defaultSize = 0.5f * 0.5f * glm::length(b.hi - b.lo);
+  Image image = compositeClearView(layers_, settings, in.camera, in.light, defaultSize, &st);
+  st.extractions = extractions_;
+  return image;
+}
+
+}  // namespace visopt

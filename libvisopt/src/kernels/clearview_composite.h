@@ -1,0 +1,150 @@
+// ClearView's compositing (Krüger, Schneider, Westermann 2006, §3.2): per pixel, the context's
+// opacity from the focus point and the importance measure, the shaders, the focus border, and
+// the blend of the volume layer, the context surface, the focus surface and the background.
+//   curvature (§3.2.1): sum over the 4 neighbours of |N(p) - N(q)| (the umbrella operator in
+//     image space); a neighbour without a hit counts as the largest difference of two unit
+//     normals, 2, so silhouettes stay opaque;
+//   opacity = saturate(max(|C - P| / s, weight * measure(P)))   (trans = 1 - opacity);
+//   measure: curvature, normalDistance / D (§3.2.2) or |surfF - surfC| / D (§3.2.3).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "core/hd.h"
+#include "kernels/clearview_extract.h"
+#include "kernels/clearview_shading.h"
+
+namespace visopt {
+
+inline constexpr int kClearViewDecodeEntries = 4096;
+
+enum class ClearViewMeasureKind : int { Curvature = 0, Distance = 1, ViewDistance = 2 };
+
+struct ClearViewLayersView {
+  const glm::vec3 *contextPosition = nullptr, *contextNormal = nullptr;
+  const float* contextDepth = nullptr;
+  const glm::vec3 *focusPosition = nullptr, *focusNormal = nullptr;
+  const float* focusDepth = nullptr;
+  const float* normalDistance = nullptr;
+  const glm::vec4* volume = nullptr;  // null without a volume layer
+};
+
+struct ClearViewCompositeParams {
+  int width = 0, height = 0;
+  ClearViewLayersView layers;
+  glm::vec3 eye{0.f};
+  bool headlight = true;
+  glm::vec3 lightPosition{0.f};
+  bool hasFocusPoint = false;
+  glm::vec3 focusPoint{0.f};
+  float invSize = 1.f;      // 1 / s
+  float invDistance = 1.f;  // 1 / D
+  float weight = 1.f;
+  ClearViewMeasureKind measure = ClearViewMeasureKind::Curvature;
+  ClearViewShaderKind contextShader = ClearViewShaderKind::Skin;
+  ClearViewShaderKind focusShader = ClearViewShaderKind::Bone;
+  glm::vec3 contextColor{0.8f}, focusColor{0.8f};  // display values
+  glm::vec3 background{0.f};                       // display value
+  float ambient = 0.15f;
+  bool border = true;
+  const float* decode = nullptr;  // kClearViewDecodeEntries display -> linear values
+  glm::vec3* out = nullptr;       // linear light
+};
+
+// The image-space curvature of a surface layer at pixel (x, y) (§3.1, Fig. 5).
+VISOPT_HD inline float clearViewCurvature(const glm::vec3* normal, const float* depth, int w, int h,
+                                          int x, int y) {
+  const int64_t i = int64_t(y) * w + x;
+  const glm::vec3 n = normal[i];
+  float sum = 0.f;
+  const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+  for (int k = 0; k < 4; ++k) {
+    const int qx = x + dx[k], qy = y + dy[k];
+    if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;  // the image's edge is no silhouette
+    const int64_t q = int64_t(qy) * w + qx;
+    sum += depth[q] >= kClearViewNoHit ? 2.f : glm::length(n - normal[q]);
+  }
+  return sum;
+}
+
+// The context's opacity at a pixel with a context hit (the measure's term and the distance
+// term), before the border.
+VISOPT_HD inline float clearViewContextOpacity(const ClearViewCompositeParams& p, int x, int y) {
+  const int64_t i = int64_t(y) * p.width + x;
+  const ClearViewLayersView& L = p.layers;
+  if (!p.hasFocusPoint) return 1.f;
+  const float near = glm::length(p.focusPoint - L.contextPosition[i]) * p.invSize;
+  float m = 0.f;
+  switch (p.measure) {
+    case ClearViewMeasureKind::Distance:
+      m = L.normalDistance[i] >= kClearViewNoHit ? 1.f : L.normalDistance[i] * p.invDistance;
+      break;
+    case ClearViewMeasureKind::ViewDistance:
+      m = L.focusDepth[i] >= kClearViewNoHit
+              ? 1.f
+              : fabsf(L.focusDepth[i] - L.contextDepth[i]) * p.invDistance;
+      break;
+    default:
+      m = clearViewCurvature(L.contextNormal, L.contextDepth, p.width, p.height, x, y);
+  }
+  return cvSaturate(fmaxf(near, p.weight * m));
+}
+
+struct ClearViewCompositeKernel {
+  ClearViewCompositeParams p;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const int x = int(pixel % p.width), y = int(pixel / p.width);
+    const ClearViewLayersView& L = p.layers;
+    const float tc = L.contextDepth[pixel], tf = L.focusDepth[pixel];
+    glm::vec3 color = p.background;
+    if (tf < kClearViewNoHit) {
+      const glm::vec3 P = L.focusPosition[pixel];
+      color = clearViewShade(p.focusShader, L.focusNormal[pixel], lightAt(P), eyeAt(P),
+                             p.focusColor, p.ambient);
+    }
+    // The context surface lies over the focus unless the focus is in front of it.
+    float near = 1.f;  // the distance term at this pixel, for the volume layer
+    if (tc < kClearViewNoHit && !(tf < tc)) {
+      const glm::vec3 P = L.contextPosition[pixel];
+      glm::vec3 c = clearViewShade(p.contextShader, L.contextNormal[pixel], lightAt(P), eyeAt(P),
+                                   p.contextColor, p.ambient);
+      const float alpha = clearViewContextOpacity(p, x, y);
+      if (p.hasFocusPoint) {
+        const float d = glm::length(p.focusPoint - P) * p.invSize;
+        near = cvSaturate(d);
+        // §3.2.4: the border where the sphere about C meets the surface, darkened.
+        if (p.border && d >= 0.95f && d <= 1.f) c *= 0.3f;
+      }
+      color = alpha * c + (1.f - alpha) * color;
+    } else if (tf < kClearViewNoHit && p.hasFocusPoint) {
+      near = cvSaturate(glm::length(p.focusPoint - L.focusPosition[pixel]) * p.invSize);
+    }
+    if (L.volume) {  // premultiplied, made transparent about the focus point like the surface
+      const glm::vec4 v = L.volume[pixel];
+      color = near * glm::vec3(v) + (1.f - near * v.w) * color;
+    }
+    p.out[pixel] = glm::vec3(toLinear(color.r), toLinear(color.g), toLinear(color.b));
+  }
+
+  VISOPT_HD float toLinear(float v) const {
+    return p.decode[int(cvSaturate(v) * float(kClearViewDecodeEntries - 1) + 0.5f)];
+  }
+
+  VISOPT_HD glm::vec3 eyeAt(glm::vec3 P) const {
+    const glm::vec3 v = p.eye - P;
+    const float len = glm::length(v);
+    return len > 0.f ? v / len : glm::vec3(0.f, 0.f, 1.f);
+  }
+  VISOPT_HD glm::vec3 lightAt(glm::vec3 P) const {
+    if (p.headlight) return eyeAt(P);
+    const glm::vec3 v = p.lightPosition - P;
+    const float len = glm::length(v);
+    return len > 0.f ? v / len : eyeAt(P);
+  }
+};
+
+}  // namespace visopt

@@ -1,0 +1,186 @@
+// ClearView's layer extraction (Krüger, Schneider, Westermann 2006, §3.1): per pixel, the first
+// hit of the view ray with the context surface and with the focus surface (world position,
+// outward normal from the central-difference gradient at the hit, depth along the ray), the
+// distance from the context hit to the focus surface along the context's inward normal (the
+// distance-based measure, §3.2.2: the paper's extra pass from the position texture along the
+// normal texture), and optionally the volume layer: the transfer function's matter in front of
+// the first surface, composited front to back.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "core/hd.h"
+#include "kernels/ray_box.h"
+#include "kernels/transfer_lookup.h"
+
+namespace visopt {
+
+// What counts as no hit: depths and distances are this large.
+inline constexpr float kClearViewNoHit = 3.0e38f;
+
+// One surface layer's source: inside where sign * (field - iso) >= 0 (sign +1 for an isosurface
+// of a scalar inside-high, -1 for an SDF's zero set, inside negative).
+struct ClearViewSurfaceField {
+  FieldView field;
+  float iso = 0.f;
+  float sign = 1.f;
+  VISOPT_HD VISOPT_INLINE float inside(glm::vec3 idx) const {
+    return sign * (field.sample(idx) - iso);
+  }
+};
+
+// One surface layer, structure of arrays, one entry per pixel (row 0 at the top).
+struct ClearViewSurfaceOut {
+  glm::vec3* position = nullptr;  // world units
+  glm::vec3* normal = nullptr;    // outward, unit; zero where there is no hit
+  float* depth = nullptr;         // ray parameter in world units; kClearViewNoHit: no hit
+};
+
+struct ClearViewExtractParams {
+  FrustumMap camera;  // dims.x, dims.y = image size
+  GridMap volume;
+  ClearViewSurfaceField context, focus;
+  float step = 0.5f;              // world units
+  float maxNormalDistance = 0.f;  // how far the distance measure looks, world units
+  ClearViewSurfaceOut contextOut, focusOut;
+  float* normalDistance = nullptr;  // kClearViewNoHit where the focus is not found
+  // The volume layer (optional): normalised scalars and the baked transfer table.
+  bool volumeLayer = false;
+  FieldView scalars;
+  TransferLookup transfer;
+  glm::vec4* volumeOut = nullptr;  // premultiplied rgb (the albedo as emission), alpha
+};
+
+// The first t in [t0, t1] where s.inside() >= 0, refined by bisection of the last step to well
+// below a voxel (12 halvings); false when none. An isosurface is marched in steps of `step`; an
+// SDF (sign < 0, values in world units) is sphere traced, in steps of 0.9 of its distance,
+// at least a quarter of `step` (a shell thinner than a voxel is not stepped over; the
+// renderer's surface march does the same, kernels/surface_march.h) and at most 8 steps.
+VISOPT_HD inline bool clearViewFirstHit(const ClearViewSurfaceField& s, glm::vec3 o, glm::vec3 d,
+                                        float t0, float t1, float step, float& tHit) {
+  if (!(t1 >= t0)) return false;
+  const bool sdf = s.sign < 0.f;
+  const float minStep = sdf ? 0.25f * step : step;
+  float prevT = t0;
+  float v = s.inside(o + t0 * d);
+  if (v >= 0.f) {  // the ray enters the box inside the surface
+    tHit = t0;
+    return true;
+  }
+  for (int n = 0; n < 1 << 20 && prevT < t1; ++n) {
+    const float advance = sdf ? fminf(fmaxf(-0.9f * v, minStep), 8.f * step) : step;
+    const float t = fminf(prevT + advance, t1);
+    v = s.inside(o + t * d);
+    if (v >= 0.f) {
+      float lo = prevT, hi = t;  // inside(lo) < 0 <= inside(hi)
+      for (int b = 0; b < 12; ++b) {
+        const float mid = 0.5f * (lo + hi);
+        if (s.inside(o + mid * d) >= 0.f)
+          hi = mid;
+        else
+          lo = mid;
+      }
+      tHit = 0.5f * (lo + hi);
+      return true;
+    }
+    prevT = t;
+  }
+  return false;
+}
+
+// The outward unit normal at index position p: minus the sign-corrected gradient of the field
+// by central differences (one voxel each side), taken to world space.
+VISOPT_HD inline glm::vec3 clearViewNormal(const ClearViewSurfaceField& s, const GridMap& g,
+                                           glm::vec3 p) {
+  const FieldView& f = s.field;
+  const glm::vec3 gi(
+      f.sample(p + glm::vec3(1.f, 0.f, 0.f)) - f.sample(p - glm::vec3(1.f, 0.f, 0.f)),
+      f.sample(p + glm::vec3(0.f, 1.f, 0.f)) - f.sample(p - glm::vec3(0.f, 1.f, 0.f)),
+      f.sample(p + glm::vec3(0.f, 0.f, 1.f)) - f.sample(p - glm::vec3(0.f, 0.f, 1.f)));
+  // d f / d world = direction * (d f / d index / spacing).
+  const glm::vec3 gw = g.direction * (0.5f * gi / g.spacing);
+  const float len = glm::length(gw);
+  if (!(len > 0.f)) return glm::vec3(0.f);
+  return (-s.sign / len) * gw;
+}
+
+struct ClearViewExtractKernel {
+  ClearViewExtractParams p;
+
+  // One pixel; returns the number of layers hit (for the caller's statistics).
+  VISOPT_HD int64_t operator()(int64_t pixel) const {
+    const int w = p.camera.dims.x, h = p.camera.dims.y;
+    const int px = int(pixel % w), row = int(pixel / w);
+    const int py = h - 1 - row;
+    const glm::vec3 dirWorld = p.camera.rayDirection(float(px), float(py));
+    const glm::vec3 o = p.volume.toIndex(p.camera.eye);
+    const glm::vec3 d = p.volume.directionToIndex(dirWorld);
+    const RayInterval box = intersectBox(o, d, glm::vec3(p.volume.dims - 1));
+    int64_t hits = 0;
+    float tc = kClearViewNoHit, tf = kClearViewNoHit;
+    const bool inBox = !box.empty();
+    if (inBox && clearViewFirstHit(p.context, o, d, box.t0, box.t1, p.step, tc)) {
+      const glm::vec3 idx = o + tc * d;
+      p.contextOut.position[pixel] = p.volume.toWorld(idx);
+      glm::vec3 n = clearViewNormal(p.context, p.volume, idx);
+      if (n == glm::vec3(0.f)) n = -dirWorld;  // a flat field: face the viewer
+      p.contextOut.normal[pixel] = n;
+      ++hits;
+      // §3.2.2: along the inward normal to the focus surface, starting a step inside.
+      float dist = kClearViewNoHit;
+      if (p.maxNormalDistance > 0.f) {
+        const glm::vec3 dn = p.volume.directionToIndex(-n);
+        const RayInterval nbox = intersectBox(idx, dn, glm::vec3(p.volume.dims - 1));
+        const float end = fminf(nbox.t1, p.maxNormalDistance);
+        float tn;
+        if (!nbox.empty() && clearViewFirstHit(p.focus, idx, dn, 0.f, end, p.step, tn)) dist = tn;
+      }
+      p.normalDistance[pixel] = dist;
+    } else {
+      tc = kClearViewNoHit;
+      p.contextOut.position[pixel] = glm::vec3(0.f);
+      p.contextOut.normal[pixel] = glm::vec3(0.f);
+      p.normalDistance[pixel] = kClearViewNoHit;
+    }
+    p.contextOut.depth[pixel] = tc;
+    if (inBox && clearViewFirstHit(p.focus, o, d, box.t0, box.t1, p.step, tf)) {
+      const glm::vec3 idx = o + tf * d;
+      p.focusOut.position[pixel] = p.volume.toWorld(idx);
+      glm::vec3 n = clearViewNormal(p.focus, p.volume, idx);
+      if (n == glm::vec3(0.f)) n = -dirWorld;
+      p.focusOut.normal[pixel] = n;
+      ++hits;
+    } else {
+      tf = kClearViewNoHit;
+      p.focusOut.position[pixel] = glm::vec3(0.f);
+      p.focusOut.normal[pixel] = glm::vec3(0.f);
+    }
+    p.focusOut.depth[pixel] = tf;
+    if (p.volumeLayer) p.volumeOut[pixel] = volumeInFront(o, d, box, fminf(tc, tf));
+    return hits;
+  }
+
+  // Emission-absorption of the transfer function's matter over [t0, min(tEnd, t1)]: each step
+  // of length h adds T (1 - exp(-mu h)) albedo and multiplies T by exp(-mu h).
+  VISOPT_HD glm::vec4 volumeInFront(glm::vec3 o, glm::vec3 d, RayInterval box, float tEnd) const {
+    glm::vec3 c(0.f);
+    float T = 1.f;
+    if (box.empty()) return glm::vec4(0.f);
+    const float end = fminf(box.t1, tEnd);
+    for (float t = box.t0 + 0.5f * p.step; t < end && T > 1e-3f; t += p.step) {
+      const float s = p.scalars.sample(o + t * d);
+      const glm::vec4 ae = p.transfer.at(s);
+      const float a = 1.f - expf(-ae.w * p.step);
+      c += T * a * glm::vec3(ae);
+      T *= 1.f - a;
+    }
+    return glm::vec4(c, 1.f - T);
+  }
+};
+
+}  // namespace visopt

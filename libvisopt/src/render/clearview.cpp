@@ -1,0 +1,194 @@
+#include "render/clearview.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "core/colormap_eval.h"
+#include "core/frustum_map.h"
+#include "exec/parallel.h"
+#include "kernels/clearview_extract.h"
+#include "visopt/error.h"
+#include "visopt/frustum.h"
+
+namespace visopt {
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The sRGB encoding of a linear colour (the shaders work on display values).
+glm::vec3 toDisplay(glm::vec3 c) {
+  auto enc = [](float v) {
+    v = std::clamp(v, 0.f, 1.f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+  };
+  return {enc(c.r), enc(c.g), enc(c.b)};
+}
+
+ClearViewSurfaceField fieldOf(const ClearViewSurfaceSource& s) {
+  ClearViewSurfaceField f;
+  f.field = FieldView(*s.field);
+  f.iso = s.iso;
+  f.sign = s.sign;
+  return f;
+}
+
+}  // namespace
+
+size_t ClearViewLayers::bytes() const {
+  return contextPosition.bytes() + contextNormal.bytes() + focusPosition.bytes() +
+         focusNormal.bytes() + contextDepth.bytes() + focusDepth.bytes() + normalDistance.bytes() +
+         volume.bytes();
+}
+
+ClearViewLayersView ClearViewLayers::view() const {
+  ClearViewLayersView v;
+  v.contextPosition = contextPosition.data();
+  v.contextNormal = contextNormal.data();
+  v.contextDepth = contextDepth.data();
+  v.focusPosition = focusPosition.data();
+  v.focusNormal = focusNormal.data();
+  v.focusDepth = focusDepth.data();
+  v.normalDistance = normalDistance.data();
+  v.volume = volume.size() ? volume.data() : nullptr;
+  return v;
+}
+
+void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
+                            const Camera& camera, int width, int height,
+                            const ClearViewSurfaceSource& context,
+                            const ClearViewSurfaceSource& focus, bool volumeLayer,
+                            ClearViewLayers& out) {
+  if (!context.field || !focus.field)
+    throw Error(ErrorKind::Usage, "ClearView: a layer without a field");
+  const GridSpec& grid = volume.grid();
+  if (context.field->grid().dims != grid.dims || focus.field->grid().dims != grid.dims)
+    throw Error(ErrorKind::Usage, "ClearView: the layers' fields must be on the volume's grid");
+  const size_t n = size_t(width) * size_t(height);
+  if (out.width != width || out.height != height || out.contextDepth.size() != n) {
+    out.contextPosition = DeviceBuffer<glm::vec3>(n);
+    out.contextNormal = DeviceBuffer<glm::vec3>(n);
+    out.focusPosition = DeviceBuffer<glm::vec3>(n);
+    out.focusNormal = DeviceBuffer<glm::vec3>(n);
+    out.contextDepth = DeviceBuffer<float>(n);
+    out.focusDepth = DeviceBuffer<float>(n);
+    out.normalDistance = DeviceBuffer<float>(n);
+  }
+  if (volumeLayer && out.volume.size() != n) out.volume = DeviceBuffer<glm::vec4>(n);
+  if (!volumeLayer) out.volume = DeviceBuffer<glm::vec4>();
+  out.width = width;
+  out.height = height;
+
+  ClearViewExtractParams p;
+  p.camera = FrustumMap(FrustumGrid::forCamera(camera, width, height, grid.worldBounds(), 1, 1.f));
+  p.volume = GridMap(grid);
+  p.context = fieldOf(context);
+  p.focus = fieldOf(focus);
+  p.step = 0.5f * grid.minSpacing();
+  const glm::vec3 diagonal = grid.worldBounds().hi - grid.worldBounds().lo;
+  p.maxNormalDistance = 0.25f * glm::length(diagonal);
+  p.contextOut = {out.contextPosition.data(), out.contextNormal.data(), out.contextDepth.data()};
+  p.focusOut = {out.focusPosition.data(), out.focusNormal.data(), out.focusDepth.data()};
+  p.normalDistance = out.normalDistance.data();
+  if (volumeLayer) {
+    p.volumeLayer = true;
+    p.scalars = FieldView(volume.normalized);
+    p.transfer = TransferLookup{transfer.data(), int(transfer.size())};
+    p.volumeOut = out.volume.data();
+  }
+  const ClearViewExtractKernel kernel{p};
+  exec::reduce("clearview: extract", int64_t(n), int64_t(0), kernel,
+               [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+  int64_t c = 0, f = 0;
+  for (size_t i = 0; i < n; ++i) {
+    c += out.contextDepth[i] < kClearViewNoHit;
+    f += out.focusDepth[i] < kClearViewNoHit;
+  }
+  out.contextPixels = c;
+  out.focusPixels = f;
+}
+
+namespace {
+
+size_t focusPixelIndex(const ClearViewLayers& layers, glm::vec2 focusPixel) {
+  const float fx = focusPixel.x < 0.f ? 0.5f * float(layers.width) : focusPixel.x;
+  const float fy = focusPixel.y < 0.f ? 0.5f * float(layers.height) : focusPixel.y;
+  const int x = std::clamp(int(std::floor(fx)), 0, layers.width - 1);
+  const int y = std::clamp(int(std::floor(fy)), 0, layers.height - 1);
+  return size_t(y) * size_t(layers.width) + size_t(x);
+}
+
+}  // namespace
+
+float automaticClearViewSize(const ClearViewLayers& layers, glm::vec2 focusPixel, float fallback) {
+  if (layers.width <= 0 || layers.height <= 0) return fallback;
+  const size_t i = focusPixelIndex(layers, focusPixel);
+  const float tc = layers.contextDepth[i], tf = layers.focusDepth[i];
+  if (!(tc < kClearViewNoHit) || !(tf < kClearViewNoHit) || !(tf > tc)) return fallback;
+  return std::max(2.f * (tf - tc), 0.1f * fallback);
+}
+
+bool clearViewFocusPoint(const ClearViewLayers& layers, glm::vec2 focusPixel, glm::vec3& point) {
+  if (layers.width <= 0 || layers.height <= 0) return false;
+  const size_t i = focusPixelIndex(layers, focusPixel);
+  if (!(layers.focusDepth[i] < kClearViewNoHit)) return false;
+  point = layers.focusPosition[i];
+  return true;
+}
+
+Image compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& settings,
+                         const Camera& camera, const PointLight& light, float defaultSize,
+                         ClearViewStats* stats) {
+  if (settings.width != layers.width || settings.height != layers.height)
+    throw Error(ErrorKind::Usage, "ClearView: the image size differs from the layers'");
+  const auto start = std::chrono::steady_clock::now();
+  ClearViewCompositeParams p;
+  p.width = layers.width;
+  p.height = layers.height;
+  p.layers = layers.view();
+  p.eye = camera.eye;
+  p.headlight = settings.headlight;
+  p.lightPosition = light.position;
+  p.hasFocusPoint = clearViewFocusPoint(layers, settings.focusPixel, p.focusPoint);
+  const float size = settings.size > 0.f
+                         ? settings.size
+                         : automaticClearViewSize(layers, settings.focusPixel, defaultSize);
+  const float distance = settings.distanceScale > 0.f ? settings.distanceScale : size;
+  p.invSize = 1.f / size;
+  p.invDistance = 1.f / distance;
+  p.weight = settings.weight;
+  p.measure = static_cast<ClearViewMeasureKind>(static_cast<int>(settings.measure));
+  p.contextShader = static_cast<ClearViewShaderKind>(static_cast<int>(settings.contextShader));
+  p.focusShader = static_cast<ClearViewShaderKind>(static_cast<int>(settings.focusShader));
+  p.contextColor = toDisplay(settings.contextColor);
+  p.focusColor = toDisplay(settings.focusColor);
+  p.background = toDisplay(settings.background);
+  p.ambient = settings.ambient;
+  p.border = settings.border;
+  // Decoding display values to linear light through a table: three powf per pixel would cost
+  // the compositing more than all of its blending.
+  DeviceBuffer<float> decode(kClearViewDecodeEntries);
+  for (int i = 0; i < kClearViewDecodeEntries; ++i)
+    decode[size_t(i)] = srgbToLinear(float(i) / float(kClearViewDecodeEntries - 1));
+  p.decode = decode.data();
+  const size_t n = size_t(p.width) * size_t(p.height);
+  DeviceBuffer<glm::vec3> linear(n);
+  p.out = linear.data();
+  exec::parallelFor("clearview: composite", int64_t(n), ClearViewCompositeKernel{p});
+  Image image(p.width, p.height);
+  std::copy(linear.data(), linear.data() + n, image.pixels.begin());
+  if (stats) {
+    stats->compositeMs = msSince(start);
+    stats->hasFocusPoint = p.hasFocusPoint;
+    stats->focusPoint = p.focusPoint;
+    stats->contextPixels = layers.contextPixels;
+    stats->focusPixels = layers.focusPixels;
+  }
+  return image;
+}
+
+}  // namespace visopt

@@ -287,9 +287,10 @@ TEST(ClearViewCompositing, TheBorderIsExactlyThePixelsAtZeroNinetyFiveToOneSize)
   const Camera cam = frontCamera();
   const PointLight light;
   cv.border = false;
-  const Image plain = compositeClearView(L, cv, cam, light, 1.f, nullptr);
+  Image plain, ringed;
+  compositeClearView(L, cv, cam, light, 1.f, nullptr, plain);
   cv.border = true;
-  const Image ringed = compositeClearView(L, cv, cam, light, 1.f, nullptr);
+  compositeClearView(L, cv, cam, light, 1.f, nullptr, ringed);
   int ring = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {

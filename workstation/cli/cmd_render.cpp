@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "clearview_spec.h"
 #include "cli_common.h"
 #include "commands.h"
 #include "visopt/error.h"
@@ -19,6 +20,7 @@ Runner addRenderCommand(CLI::App& app) {
   struct Options {
     std::string volume, scene, session, tf, size = "512x512", camera, precision = "fp32", out;
     std::string deviationColormap = "viridis";
+    std::string clearview;
     int resolution = 128;
     float step = RenderSettings{}.stepFactor;  // the library's default
     bool deviationView = false, preview = false, json = false, noJitter = false;
@@ -52,11 +54,24 @@ Runner addRenderCommand(CLI::App& app) {
   app.add_flag("--no-jitter", o->noJitter, "Sample at segment midpoints (shows wood grain)");
   app.add_option("--out", o->out, "Output PNG")->required();
   app.add_flag("--json", o->json, "Print per-stage times and the memory ledger as JSON");
+  app.add_option("--clearview", o->clearview,
+                 "ClearView hotspot render (Krüger et al. 2006): comma-separated key=value, see "
+                 "docs/clearview.md");
 
   return [o, &app]() {
     resetStageTimings();
     const auto t0 = std::chrono::steady_clock::now();
     auto given = [&app](const char* name) { return app.get_option(name)->count() > 0; };
+    const bool clearview = given("--clearview");
+    if (clearview) {
+      // ClearView has its own layers and shaders: the ray caster's options would do nothing.
+      for (const char* other :
+           {"--deviation-view", "--preview", "--deviation-colormap", "--step", "--no-jitter"})
+        if (given(other))
+          throw Error(ErrorKind::Usage, std::string("--clearview and ") + other +
+                                            " cannot be combined (the ClearView render has "
+                                            "its own layers and shaders)");
+    }
     checkPngOutput(o->out);  // before any loading: a device or folder is refused up front
     // A session supplies the scene and the render settings; explicit options override them.
     std::optional<Session> session;
@@ -104,6 +119,67 @@ Runner addRenderCommand(CLI::App& app) {
     if (!session || given("--deviation-colormap"))
       settings.deviationColormap = parseColormap(o->deviationColormap);
     if (!session || o->noJitter) settings.jitter = !o->noJitter;
+    if (clearview) {
+      // After the scene, the camera and the size: the layers' defaults follow the scene.
+      const ClearViewSettings cv =
+          parseClearViewSpec(engine, o->clearview, {settings.width, settings.height});
+      ClearViewStats cvStats;
+      Image image;
+      try {
+        image = engine.renderClearView(cv, &cvStats);
+      } catch (const Error& e) {
+        // The Engine checks the layers against the scene: a usage error is this option's.
+        if (e.kind() != ErrorKind::Usage) throw;
+        throw asClearViewOptionError(e);
+      }
+      const auto tw = std::chrono::steady_clock::now();
+      writePng(image, o->out);
+      const double writeMs = msSince(tw);
+      const double renderMs = cvStats.extractMs + cvStats.compositeMs;
+      if (o->json) {
+        const nlohmann::json focusPoint =
+            cvStats.hasFocusPoint
+                ? nlohmann::json::array(
+                      {cvStats.focusPoint.x, cvStats.focusPoint.y, cvStats.focusPoint.z})
+                : nlohmann::json(nullptr);
+        nlohmann::json j = {{"command", "render"},
+                            {"backend", backendDescription()},
+                            {"input", engine.volume().sourcePath},
+                            {"precision", toString(precision)},
+                            {"out", o->out},
+                            {"image",
+                             {{"width", cv.width},
+                              {"height", cv.height},
+                              {"rendered_width", image.width},
+                              {"rendered_height", image.height}}},
+                            {"times_ms",
+                             {{"load", loadMs},
+                              {"render", renderMs},
+                              {"write_png", writeMs},
+                              {"total", msSince(t0)}}},
+                            {"clearview",
+                             {{"context", describeClearViewLayer(cv.context)},
+                              {"focus", describeClearViewLayer(cv.focus)},
+                              {"measure", toString(cv.measure)},
+                              {"extract_ms", cvStats.extractMs},
+                              {"composite_ms", cvStats.compositeMs},
+                              {"context_pixels", cvStats.contextPixels},
+                              {"focus_pixels", cvStats.focusPixels},
+                              {"focus_point", focusPoint}}},
+                            {"clearview_extract_ms", cvStats.extractMs},
+                            {"clearview_composite_ms", cvStats.compositeMs},
+                            {"stages", stageTimingsJson()},
+                            {"memory", ledgerJson(engine.ledger())}};
+        if (session) j["session"] = {{"path", o->session}, {"data", sessionData}};
+        std::printf("%s\n", j.dump(2).c_str());
+      } else {
+        std::printf("wrote %s (%dx%d ClearView, %.0f ms extract, %.1f ms composite, %s)\n",
+                    o->out.c_str(), cv.width, cv.height, cvStats.extractMs, cvStats.compositeMs,
+                    backendDescription().c_str());
+      }
+      return kOk;
+    }
+
     RenderStats stats;
     Image image = engine.render(settings, &stats);
     const auto tw = std::chrono::steady_clock::now();

@@ -83,7 +83,7 @@ struct ClearViewStats {
   double extractMs = 0.0;    // this call's extraction (0 when reused)
   double compositeMs = 0.0;  // this call's compositing
   bool hasFocusPoint = false;
-  glm::vec3 focusPoint{0.f};                   // C in world units, when the focus pixel hit a layer
+  glm::vec3 focusPoint{0.f};  // C in world units, when the focus pixel sees the focus layer
   int64_t contextPixels = 0, focusPixels = 0;  // pixels where each surface layer was hit
 };
 

@@ -161,6 +161,11 @@ class Engine {
   // compositing runs (stats->extracted says which). Usage error for settings that fail
   // checkClearViewSettings or name a context surface or importance the scene lacks.
   Image renderClearView(const ClearViewSettings& settings, ClearViewStats* stats = nullptr);
+  // The same into `image`, whose pixels are reused when it already has the size: an interactive
+  // caller keeps its frame, since a new 800x600 image costs page faults worth about as much as
+  // the compositing itself (docs/clearview.md).
+  void renderClearView(const ClearViewSettings& settings, Image& image,
+                       ClearViewStats* stats = nullptr);
 
   const MemoryLedger& ledger() const;
 

@@ -26,8 +26,8 @@ ClearViewCache::~ClearViewCache() {
   if (ledgerToken_ && ledger_) ledger_->remove(ledgerToken_);
 }
 
-Image ClearViewCache::render(const ClearViewInputs& in, const ClearViewSettings& settings,
-                             ClearViewStats* stats) {
+void ClearViewCache::render(const ClearViewInputs& in, const ClearViewSettings& settings,
+                            ClearViewStats* stats, Image& image) {
   Key key;
   key.camera = in.camera;
   key.width = settings.width;
@@ -62,9 +62,8 @@ Image ClearViewCache::render(const ClearViewInputs& in, const ClearViewSettings&
   }
   const Bounds b = in.volume->grid().worldBounds();
   const float defaultSize = 0.5f * 0.5f * glm::length(b.hi - b.lo);
-  Image image = compositeClearView(layers_, settings, in.camera, in.light, defaultSize, &st);
+  compositeClearView(layers_, settings, in.camera, in.light, defaultSize, &st, image);
   st.extractions = extractions_;
-  return image;
 }
 
 }  // namespace visopt

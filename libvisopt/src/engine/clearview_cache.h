@@ -35,7 +35,8 @@ class ClearViewCache {
   ClearViewCache(const ClearViewCache&) = delete;
   ClearViewCache& operator=(const ClearViewCache&) = delete;
 
-  Image render(const ClearViewInputs& in, const ClearViewSettings& settings, ClearViewStats* stats);
+  void render(const ClearViewInputs& in, const ClearViewSettings& settings, ClearViewStats* stats,
+              Image& image);
   int64_t extractions() const { return extractions_; }
 
  private:

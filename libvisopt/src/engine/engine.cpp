@@ -366,6 +366,13 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
 }
 
 Image Engine::renderClearView(const ClearViewSettings& settings, ClearViewStats* stats) {
+  Image image;
+  renderClearView(settings, image, stats);
+  return image;
+}
+
+void Engine::renderClearView(const ClearViewSettings& settings, Image& image,
+                             ClearViewStats* stats) {
   if (!impl_->volume) throw Error(ErrorKind::Usage, "no volume loaded");
   checkClearViewSettings(settings);
   const Volume& volume = *impl_->volume;
@@ -416,7 +423,7 @@ Image Engine::renderClearView(const ClearViewSettings& settings, ClearViewStats*
   in.sceneRevision = impl_->sceneRevision;
   in.importanceRevision = impl_->importanceRevision;
   if (!impl_->clearView) impl_->clearView = std::make_unique<ClearViewCache>(&impl_->ledger);
-  return impl_->clearView->render(in, settings, stats);
+  impl_->clearView->render(in, settings, stats, image);
 }
 
 const MemoryLedger& Engine::ledger() const {

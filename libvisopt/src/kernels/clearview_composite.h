@@ -14,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "core/hd.h"
+#include "core/min_max.h"
 #include "kernels/clearview_extract.h"
 #include "kernels/clearview_shading.h"
 
@@ -90,7 +91,7 @@ VISOPT_HD inline float clearViewContextOpacity(const ClearViewCompositeParams& p
     default:
       m = clearViewCurvature(L.contextNormal, L.contextDepth, p.width, p.height, x, y);
   }
-  return cvSaturate(fmaxf(near, p.weight * m));
+  return cvSaturate(maxOf(near, p.weight * m));
 }
 
 struct ClearViewCompositeKernel {

@@ -15,6 +15,7 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "core/hd.h"
+#include "core/min_max.h"
 #include "kernels/ray_box.h"
 #include "kernels/transfer_lookup.h"
 
@@ -73,8 +74,8 @@ VISOPT_HD inline bool clearViewFirstHit(const ClearViewSurfaceField& s, glm::vec
     return true;
   }
   for (int n = 0; n < 1 << 20 && prevT < t1; ++n) {
-    const float advance = sdf ? fminf(fmaxf(-0.9f * v, minStep), 8.f * step) : step;
-    const float t = fminf(prevT + advance, t1);
+    const float advance = sdf ? minOf(maxOf(-0.9f * v, minStep), 8.f * step) : step;
+    const float t = minOf(prevT + advance, t1);
     v = s.inside(o + t * d);
     if (v >= 0.f) {
       float lo = prevT, hi = t;  // inside(lo) < 0 <= inside(hi)
@@ -136,7 +137,7 @@ struct ClearViewExtractKernel {
       if (p.maxNormalDistance > 0.f) {
         const glm::vec3 dn = p.volume.directionToIndex(-n);
         const RayInterval nbox = intersectBox(idx, dn, glm::vec3(p.volume.dims - 1));
-        const float end = fminf(nbox.t1, p.maxNormalDistance);
+        const float end = minOf(nbox.t1, p.maxNormalDistance);
         float tn;
         if (!nbox.empty() && clearViewFirstHit(p.focus, idx, dn, 0.f, end, p.step, tn)) dist = tn;
       }
@@ -161,7 +162,7 @@ struct ClearViewExtractKernel {
       p.focusOut.normal[pixel] = glm::vec3(0.f);
     }
     p.focusOut.depth[pixel] = tf;
-    if (p.volumeLayer) p.volumeOut[pixel] = volumeInFront(o, d, box, fminf(tc, tf));
+    if (p.volumeLayer) p.volumeOut[pixel] = volumeInFront(o, d, box, minOf(tc, tf));
     return hits;
   }
 
@@ -171,7 +172,7 @@ struct ClearViewExtractKernel {
     glm::vec3 c(0.f);
     float T = 1.f;
     if (box.empty()) return glm::vec4(0.f);
-    const float end = fminf(box.t1, tEnd);
+    const float end = minOf(box.t1, tEnd);
     for (float t = box.t0 + 0.5f * p.step; t < end && T > 1e-3f; t += p.step) {
       const float s = p.scalars.sample(o + t * d);
       const glm::vec4 ae = p.transfer.at(s);

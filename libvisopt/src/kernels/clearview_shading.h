@@ -9,13 +9,14 @@
 #include <glm/glm.hpp>
 
 #include "core/hd.h"
+#include "core/min_max.h"
 
 namespace visopt {
 
 enum class ClearViewShaderKind : int { Diffuse = 0, CoolWarm = 1, Skin = 2, Bone = 3 };
 
 VISOPT_HD inline float cvSaturate(float x) {
-  return fminf(fmaxf(x, 0.f), 1.f);
+  return minOf(maxOf(x, 0.f), 1.f);
 }
 
 // A 1D table of four evenly spaced entries, linearly interpolated at t in [0, 1].
@@ -43,7 +44,7 @@ VISOPT_HD inline ClearViewLut clearViewBoneLut() {
 // §3.2.5: diffuse with an ambient term.
 VISOPT_HD inline glm::vec3 clearViewDiffuse(glm::vec3 N, glm::vec3 L, glm::vec3 albedo,
                                             float ambient) {
-  return albedo * (ambient + (1.f - ambient) * fmaxf(glm::dot(N, L), 0.f));
+  return albedo * (ambient + (1.f - ambient) * maxOf(glm::dot(N, L), 0.f));
 }
 
 // §3.2.6: cool to warm (Gooch et al. 1998) through a 1D table indexed by the diffuse term

@@ -10,6 +10,7 @@
 #include "exec/parallel.h"
 #include "kernels/clearview_extract.h"
 #include "visopt/error.h"
+#include "visopt/exec.h"
 #include "visopt/frustum.h"
 
 namespace visopt {
@@ -140,9 +141,9 @@ bool clearViewFocusPoint(const ClearViewLayers& layers, glm::vec2 focusPixel, gl
   return true;
 }
 
-Image compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& settings,
-                         const Camera& camera, const PointLight& light, float defaultSize,
-                         ClearViewStats* stats) {
+void compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& settings,
+                        const Camera& camera, const PointLight& light, float defaultSize,
+                        ClearViewStats* stats, Image& image) {
   if (settings.width != layers.width || settings.height != layers.height)
     throw Error(ErrorKind::Usage, "ClearView: the image size differs from the layers'");
   const auto start = std::chrono::steady_clock::now();
@@ -176,11 +177,14 @@ Image compositeClearView(const ClearViewLayers& layers, const ClearViewSettings&
     decode[size_t(i)] = srgbToLinear(float(i) / float(kClearViewDecodeEntries - 1));
   p.decode = decode.data();
   const size_t n = size_t(p.width) * size_t(p.height);
-  DeviceBuffer<glm::vec3> linear(n);
-  p.out = linear.data();
+  if (image.width != p.width || image.height != p.height || image.pixels.size() != n)
+    image = Image(p.width, p.height);
+  // The CPU backend writes the image itself; a device writes to its memory, copied after.
+  const bool onHost = activeBackend() == Backend::CPU;
+  DeviceBuffer<glm::vec3> linear(onHost ? 0 : n);
+  p.out = onHost ? image.pixels.data() : linear.data();
   exec::parallelFor("clearview: composite", int64_t(n), ClearViewCompositeKernel{p});
-  Image image(p.width, p.height);
-  std::copy(linear.data(), linear.data() + n, image.pixels.begin());
+  if (!onHost) std::copy(linear.data(), linear.data() + n, image.pixels.begin());
   if (stats) {
     stats->compositeMs = msSince(start);
     stats->hasFocusPoint = p.hasFocusPoint;
@@ -188,7 +192,6 @@ Image compositeClearView(const ClearViewLayers& layers, const ClearViewSettings&
     stats->contextPixels = layers.contextPixels;
     stats->focusPixels = layers.focusPixels;
   }
-  return image;
 }
 
 }  // namespace visopt

@@ -57,8 +57,9 @@ float automaticClearViewSize(const ClearViewLayers& layers, glm::vec2 focusPixel
 
 // Composites the layers (settings.width x height must equal the layers'); `defaultSize` is the
 // fallback of automaticClearViewSize, used when settings.size is 0.
-Image compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& settings,
-                         const Camera& camera, const PointLight& light, float defaultSize,
-                         ClearViewStats* stats);
+// `image` is resized to the layers' size; its pixels are reused when it already has it.
+void compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& settings,
+                        const Camera& camera, const PointLight& light, float defaultSize,
+                        ClearViewStats* stats, Image& image);
 
 }  // namespace visopt

@@ -1,0 +1,202 @@
+// `visopt render --clearview SPEC` as a script would use it: the ClearView hotspot render
+// (Krüger et al. 2006) configured by comma-separated key=value. A malformed SPEC is a usage error
+// (exit 1) whose one line on stderr names --clearview and the offending element, and no image is
+// written; a good one writes the PNG at --size and, with --json, reports the extraction and
+// compositing times.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+#include "visopt/image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Result = visopt::testing::CliResult;
+
+Result run(const std::string& args) {
+  return visopt::testing::runCli(args, "cli-clearview");
+}
+
+std::string tmp(const std::string& name) {
+  return (fs::path(VISOPT_TEST_TMP) / "cli-clearview" / name).string();
+}
+
+// stderr without the CPU-backend notice, line by line.
+std::vector<std::string> errorLines(const std::string& err) {
+  std::vector<std::string> lines;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty() && line.find("using the CPU backend") == std::string::npos)
+      lines.push_back(line);
+  return lines;
+}
+
+// The shepp-logan scene carries one context surface (the skull) and an importance.
+const std::string kShepp = "render --scene builtin:shepp-logan --resolution 32 --size 64x48 --out ";
+
+// A SPEC the tool must refuse: exit 1, one line naming --clearview and `names`, no image.
+void expectRefused(const std::string& command, const std::string& out, const std::string& spec,
+                   const std::string& names) {
+  fs::remove(out);
+  const Result r = run(command + out + " --clearview '" + spec + "'");
+  EXPECT_EQ(r.code, 1) << spec << "\n" << r.err;
+  const std::vector<std::string> lines = errorLines(r.err);
+  ASSERT_EQ(lines.size(), 1u) << spec << "\n" << r.err;
+  EXPECT_NE(lines[0].find("--clearview"), std::string::npos) << spec << ": " << lines[0];
+  EXPECT_NE(lines[0].find(names), std::string::npos) << spec << ": " << lines[0];
+  EXPECT_FALSE(fs::exists(out)) << spec;
+}
+
+// A 24^3 float32 ball (150 in the core, 100 in the shell, 0 outside): no context surface, no
+// importance.
+std::string ballVolume() {
+  const std::string raw = tmp("ball.raw");
+  std::ofstream f(raw, std::ios::binary);
+  for (int k = 0; k < 24; ++k)
+    for (int j = 0; j < 24; ++j)
+      for (int i = 0; i < 24; ++i) {
+        const int r2 = (i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12);
+        const float v = r2 < 16 ? 150.f : (r2 < 64 ? 100.f : 0.f);
+        f.write(reinterpret_cast<const char*>(&v), 4);
+      }
+  std::ofstream(raw + ".json") << R"({"dims":[24,24,24],"type":"float32","spacing":[1,1,1]})";
+  return raw;
+}
+
+}  // namespace
+
+TEST(CliClearView, RendersTheHotspotAndReportsItsTimes) {
+  const std::string out = tmp("hotspot.png");
+  fs::remove(out);
+  const Result r = run(kShepp + out + " --clearview measure=distance,at=10:20,size=20 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);  // exactly one JSON object
+  ASSERT_TRUE(j.contains("clearview_extract_ms")) << r.out;
+  ASSERT_TRUE(j.contains("clearview_composite_ms")) << r.out;
+  EXPECT_GE(j["clearview_extract_ms"].get<double>(), 0.0);
+  EXPECT_GE(j["clearview_composite_ms"].get<double>(), 0.0);
+  const auto& cv = j["clearview"];
+  for (const char* key :
+       {"extract_ms", "composite_ms", "context_pixels", "focus_pixels", "focus_point"})
+    EXPECT_TRUE(cv.contains(key)) << key;
+  EXPECT_EQ(cv["extract_ms"], j["clearview_extract_ms"]);
+  EXPECT_EQ(cv["composite_ms"], j["clearview_composite_ms"]);
+  EXPECT_GE(cv["context_pixels"].get<long long>(), 0);
+  EXPECT_GT(cv["focus_pixels"].get<long long>(), 0);  // the tumours, importance 0.5
+  EXPECT_LE(cv["focus_pixels"].get<long long>(), 64 * 48);
+  EXPECT_TRUE(cv["focus_point"].is_null() ||
+              (cv["focus_point"].is_array() && cv["focus_point"].size() == 3u))
+      << cv["focus_point"];
+  EXPECT_EQ(cv["context"], "surface:0");     // the scene's context surface by default
+  EXPECT_EQ(cv["focus"], "importance:0.5");  // and its importance
+  EXPECT_EQ(j["image"]["width"], 64);
+  EXPECT_EQ(j["image"]["height"], 48);
+  ASSERT_TRUE(fs::exists(out));
+  const visopt::Image image = visopt::readPng(out);
+  EXPECT_EQ(image.width, 64);
+  EXPECT_EQ(image.height, 48);
+}
+
+TEST(CliClearView, EveryKeyIsAccepted) {
+  const std::string out = tmp("every-key.png");
+  fs::remove(out);
+  const Result r = run(kShepp + out +
+                       " --clearview 'context=iso:0.25,focus=importance,volume=1,"
+                       "measure=view-distance,shader=cool-warm,focus-shader=diffuse,at=32.5:-1,"
+                       "size=15,weight=2,distance-scale=4,border=0,ambient=0.3,light=scene'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("ClearView"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out));
+  // An empty SPEC keeps every default; surrounding blanks are ignored.
+  ASSERT_EQ(run(kShepp + out + " --clearview ''").code, 0);
+  ASSERT_EQ(run(kShepp + out + " --clearview ' size=20 , focus=importance:1 '").code, 0);
+}
+
+TEST(CliClearView, MalformedSpecsAreUsageErrorsNamingTheElement) {
+  const std::string out = tmp("malformed.png");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"colour=red", "colour=red"},                  // unknown key
+      {"size=10,size=20", "size=20"},                // duplicate key
+      {"measure", "measure"},                        // missing '='
+      {"size=abc", "size=abc"},                      // bad number
+      {"at=10:2x", "at=10:2x"},                      // bad number, trailing garbage
+      {"weight=nan", "weight=nan"},                  // NaN
+      {"size=inf", "size=inf"},                      // infinity
+      {"distance-scale=-1", "distance-scale=-1"},    // out of range
+      {"size=0", "size=0"},                          // out of range: the size must be > 0
+      {"weight=-0.5", "weight=-0.5"},                // out of range
+      {"ambient=1.5", "ambient=1.5"},                // out of range
+      {"weight=1e60", "weight=1e60"},                // beyond a float
+      {"at=64:10", "at=64:10"},                      // outside the 64x48 image
+      {"focus=importance:0", "focus=importance:0"},  // importance isovalue not in (0, 1]
+      {"context=surface:-1", "context=surface:-1"},
+      {"context=importance", "context=importance"},  // only focus has the bare form
+      {"context=plane:3", "context=plane:3"},        // unknown layer kind
+      {"measure=flatness", "measure=flatness"},      // unknown enum word
+      {"shader=toon", "shader=toon"},
+      {"focus-shader=metal", "focus-shader=metal"},
+      {"light=sun", "light=sun"},
+      {"volume=yes", "volume=yes"},
+      {"border=2", "border=2"},
+      {"size=10,,weight=1", "empty element 2"},  // empty element
+      {"size=10,", "empty element 2"},
+      {"=3", "=3"},
+      {"size=", "size="},
+  };
+  for (const auto& [spec, names] : cases) expectRefused(kShepp, out, spec, names);
+}
+
+TEST(CliClearView, LayersMustExistInTheScene) {
+  const std::string out = tmp("layers.png");
+  // shepp-logan has one context surface.
+  expectRefused(kShepp, out, "context=surface:3", "context=surface:3");
+  // occluded-blob has no context surface: the default context must be given.
+  const std::string blob =
+      "render --scene builtin:occluded-blob --resolution 24 --size 32x32 --out ";
+  expectRefused(blob, out, "size=10", "context=iso:VALUE");
+  expectRefused(blob, out, "context=surface:0", "no context surface");
+  // A volume file has neither a context surface nor an importance (--json: no load progress).
+  const std::string ball = "render --volume " + ballVolume() + " --json --size 32x32 --out ";
+  expectRefused(ball, out, "context=iso:50", "focus=iso:VALUE");
+  expectRefused(ball, out, "context=iso:50,focus=importance", "no importance");
+  fs::remove(out);
+  const Result r = run(ball + out + " --clearview context=iso:50,focus=iso:125,size=6");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["clearview"]["context_pixels"].get<long long>(), 0);
+  EXPECT_GT(j["clearview"]["focus_pixels"].get<long long>(), 0);
+  EXPECT_TRUE(fs::exists(out));
+}
+
+TEST(CliClearView, RayCasterOptionsAreRefused) {
+  const std::string out = tmp("conflict.png");
+  for (const char* option : {"--deviation-view", "--preview"}) {
+    fs::remove(out);
+    const Result r = run(kShepp + out + " --clearview size=10 " + option);
+    EXPECT_EQ(r.code, 1) << option << "\n" << r.err;
+    const std::vector<std::string> lines = errorLines(r.err);
+    ASSERT_EQ(lines.size(), 1u) << r.err;
+    EXPECT_NE(lines[0].find("--clearview"), std::string::npos) << lines[0];
+    EXPECT_NE(lines[0].find(option), std::string::npos) << lines[0];
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST(CliClearView, TheNormalRenderIsUnchanged) {
+  const std::string out = tmp("normal.png");
+  const Result r = run(kShepp + out + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_FALSE(j.contains("clearview"));
+  EXPECT_FALSE(j.contains("clearview_extract_ms"));
+  EXPECT_GT(j["samples"].get<double>(), 0.0);
+}

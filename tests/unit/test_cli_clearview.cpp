@@ -200,3 +200,30 @@ TEST(CliClearView, TheNormalRenderIsUnchanged) {
   EXPECT_FALSE(j.contains("clearview_extract_ms"));
   EXPECT_GT(j["samples"].get<double>(), 0.0);
 }
+
+// `visopt compare` shows ClearView as a fifth panel beside the four methods of Fig. 10.
+TEST(CliClearView, CompareShowsClearViewAsTheFifthPanel) {
+  const std::string out = tmp("compare.png");
+  fs::remove(out);
+  const Result r =
+      run("compare --scene builtin:shepp-logan --resolution 48 --size 40x32 "
+          "--iterations 2 --levels 1 --clearview measure=distance --out " +
+          out + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["panels"].size(), 5u);
+  EXPECT_EQ(j["panels"][4], "clearview");
+  const visopt::Image img = visopt::readPng(out);
+  EXPECT_EQ(img.width, 5 * 40 + 4 * 4);
+  EXPECT_EQ(img.height, 32);
+  // A malformed SPEC fails before the optimisation, naming the option.
+  const Result bad =
+      run("compare --scene builtin:shepp-logan --resolution 32 --size 32x32 "
+          "--clearview measure=bogus --out " +
+          tmp("compare-bad.png"));
+  EXPECT_EQ(bad.code, 1);
+  const std::vector<std::string> lines = errorLines(bad.err);
+  ASSERT_EQ(lines.size(), 1u) << bad.err;
+  EXPECT_NE(lines[0].find("--clearview"), std::string::npos) << lines[0];
+  EXPECT_FALSE(fs::exists(tmp("compare-bad.png")));
+}

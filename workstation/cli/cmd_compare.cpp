@@ -1,8 +1,10 @@
 // visopt compare: the four methods of Himmler & Günther 2026, Fig. 10 side by side for one scene
-// and camera — maximum importance projection, cut-away, transparency modulation, and ours.
+// and camera — maximum importance projection, cut-away, transparency modulation, and ours — and
+// ClearView's hotspot (Krüger, Schneider, Westermann 2006) as a fifth.
 #include <chrono>
 #include <cstdio>
 
+#include "clearview_spec.h"
 #include "cli_common.h"
 #include "commands.h"
 #include "visopt/error.h"
@@ -11,7 +13,7 @@ namespace visopt::cli {
 
 Runner addCompareCommand(CLI::App& app) {
   struct Options {
-    std::string volume, scene, tf, importance, camera, size = "384x384", out;
+    std::string volume, scene, tf, importance, camera, size = "384x384", out, clearview;
     std::vector<std::string> contexts;
     int resolution = 128, iterations = 60, levels = 3;
     float cut = 0.3f;
@@ -31,7 +33,11 @@ Runner addCompareCommand(CLI::App& app) {
   app.add_option("--iterations", o->iterations, "Iteration cap per level for ours");
   app.add_option("--levels", o->levels, "Multigrid levels for ours");
   app.add_option("--cut-threshold", o->cut, "ghat above which the cut-away removes geometry");
-  app.add_option("--out", o->out, "Output PNG (four panels, left to right)")->required();
+  app.add_option("--clearview", o->clearview,
+                 "The fifth panel's ClearView settings, as for render --clearview "
+                 "(docs/clearview.md)")
+      ->default_str("the scene's context surface 0 over its importance");
+  app.add_option("--out", o->out, "Output PNG (five panels, left to right)")->required();
   app.add_flag("--json", o->json, "Print the panel order and times as JSON");
   return [o]() {
     const auto t0 = std::chrono::steady_clock::now();
@@ -59,11 +65,14 @@ Runner addCompareCommand(CLI::App& app) {
     s.maxIterationsPerLevel = o->iterations;
     s.levels = o->levels;
     engine.setExtinctionSettings(s);
+    // Before the optimisation, so that a malformed SPEC fails at once.
+    const ClearViewSettings cv = parseClearViewSpec(engine, o->clearview, size);
     engine.optimize();  // ours, and ghat for the baselines
 
     const RenderMethod methods[4] = {RenderMethod::MaxImportanceProjection, RenderMethod::CutAway,
                                      RenderMethod::TransparencyModulation, RenderMethod::Optimized};
-    Image panel(4 * size.x + 3 * 4, size.y);
+    constexpr int kPanels = 5;
+    Image panel(kPanels * size.x + (kPanels - 1) * 4, size.y);
     for (auto& px : panel.pixels) px = glm::vec3(1.f);  // white gutters
     nlohmann::json order = nlohmann::json::array();
     for (int m = 0; m < 4; ++m) {
@@ -77,6 +86,21 @@ Runner addCompareCommand(CLI::App& app) {
         for (int x = 0; x < size.x; ++x) panel.at(m * (size.x + 4) + x, y) = img.at(x, y);
       order.push_back(toString(methods[m]));
     }
+    {
+      // ClearView draws the base surfaces: its layers are the scene as loaded, not as optimised.
+      engine.setRenderOptimized(false);
+      Image img;
+      try {
+        img = engine.renderClearView(cv);
+      } catch (const Error& e) {
+        if (e.kind() != ErrorKind::Usage) throw;
+        throw asClearViewOptionError(e);
+      }
+      engine.setRenderOptimized(true);
+      for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) panel.at(4 * (size.x + 4) + x, y) = img.at(x, y);
+      order.push_back("clearview");
+    }
     writePng(panel, o->out);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -87,7 +111,7 @@ Runner addCompareCommand(CLI::App& app) {
                       .dump(2)
                       .c_str());
     else
-      std::printf("wrote %s: %s | %s | %s | %s\n", o->out.c_str(), toString(methods[0]),
+      std::printf("wrote %s: %s | %s | %s | %s | clearview\n", o->out.c_str(), toString(methods[0]),
                   toString(methods[1]), toString(methods[2]), toString(methods[3]));
     return kOk;
   };

@@ -26,12 +26,39 @@ inline constexpr float kClearViewNoHit = 3.0e38f;
 
 // One surface layer's source: inside where sign * (field - iso) >= 0 (sign +1 for an isosurface
 // of a scalar inside-high, -1 for an SDF's zero set, inside negative).
+// Isosurfaces may carry empty-space flags: blocks of kClearViewBlock^3 voxels where the field
+// stays below the isovalue over the block and its 26 neighbours, so that every trilinear sample
+// inside the block (which reads the block's voxels and the next ones) is outside.
+inline constexpr int kClearViewBlock = 4;
+
 struct ClearViewSurfaceField {
   FieldView field;
   float iso = 0.f;
   float sign = 1.f;
+  const uint8_t* empty = nullptr;  // per block, x fastest; null: no skipping
+  glm::ivec3 blocks{0};
+
   VISOPT_HD VISOPT_INLINE float inside(glm::vec3 idx) const {
     return sign * (field.sample(idx) - iso);
+  }
+  VISOPT_HD glm::ivec3 blockOf(glm::vec3 idx) const {
+    return glm::ivec3(floorf(idx.x / float(kClearViewBlock)),
+                      floorf(idx.y / float(kClearViewBlock)),
+                      floorf(idx.z / float(kClearViewBlock)));
+  }
+  VISOPT_HD bool emptyAt(glm::vec3 idx) const {
+    const glm::ivec3 b = glm::clamp(blockOf(idx), glm::ivec3(0), blocks - 1);
+    return empty[(int64_t(b.z) * blocks.y + b.y) * blocks.x + b.x] != 0;
+  }
+  // Where the ray o + t d (index space) leaves the block that holds o + t d.
+  VISOPT_HD float blockExit(glm::vec3 o, glm::vec3 d, float t) const {
+    const glm::ivec3 b = blockOf(o + t * d);
+    float exit = 3.0e38f;
+    for (int a = 0; a < 3; ++a) {
+      if (d[a] > 0.f) exit = minOf(exit, (float(kClearViewBlock * (b[a] + 1)) - o[a]) / d[a]);
+      if (d[a] < 0.f) exit = minOf(exit, (float(kClearViewBlock * b[a]) - o[a]) / d[a]);
+    }
+    return exit;
   }
 };
 
@@ -58,38 +85,44 @@ struct ClearViewExtractParams {
 };
 
 // The first t in [t0, t1] where s.inside() >= 0, refined by bisection of the last step to well
-// below a voxel (12 halvings); false when none. An isosurface is marched in steps of `step`; an
-// SDF (sign < 0, values in world units) is sphere traced, in steps of 0.9 of its distance,
-// at least a quarter of `step` (a shell thinner than a voxel is not stepped over; the
-// renderer's surface march does the same, kernels/surface_march.h) and at most 8 steps.
+// below a voxel (12 halvings); false when none. An isosurface is marched in steps of `step`,
+// jumping over its empty blocks (the exit of an empty block is outside too, since the flags
+// cover the neighbours); an SDF (sign < 0, values in world units) is sphere traced, in steps of
+// 0.9 of its distance, at least a quarter of `step` (a shell thinner than a voxel is not
+// stepped over; the renderer's surface march does the same, kernels/surface_march.h) and at
+// most 8 steps.
 VISOPT_HD inline bool clearViewFirstHit(const ClearViewSurfaceField& s, glm::vec3 o, glm::vec3 d,
                                         float t0, float t1, float step, float& tHit) {
   if (!(t1 >= t0)) return false;
   const bool sdf = s.sign < 0.f;
   const float minStep = sdf ? 0.25f * step : step;
-  float prevT = t0;
+  float lo = t0;  // the last position known to be outside
   float v = s.inside(o + t0 * d);
   if (v >= 0.f) {  // the ray enters the box inside the surface
     tHit = t0;
     return true;
   }
-  for (int n = 0; n < 1 << 20 && prevT < t1; ++n) {
+  for (int n = 0; n < (1 << 22) && lo < t1; ++n) {
+    if (s.empty && s.emptyAt(o + lo * d)) {
+      lo = minOf(maxOf(s.blockExit(o, d, lo), lo + 1e-3f * step), t1);
+      continue;
+    }
     const float advance = sdf ? minOf(maxOf(-0.9f * v, minStep), 8.f * step) : step;
-    const float t = minOf(prevT + advance, t1);
+    const float t = minOf(lo + advance, t1);
     v = s.inside(o + t * d);
     if (v >= 0.f) {
-      float lo = prevT, hi = t;  // inside(lo) < 0 <= inside(hi)
-      for (int b = 0; b < 12; ++b) {
-        const float mid = 0.5f * (lo + hi);
+      float a = lo, b = t;  // inside(a) < 0 <= inside(b)
+      for (int k = 0; k < 12; ++k) {
+        const float mid = 0.5f * (a + b);
         if (s.inside(o + mid * d) >= 0.f)
-          hi = mid;
+          b = mid;
         else
-          lo = mid;
+          a = mid;
       }
-      tHit = 0.5f * (lo + hi);
+      tHit = 0.5f * (a + b);
       return true;
     }
-    prevT = t;
+    lo = t;
   }
   return false;
 }

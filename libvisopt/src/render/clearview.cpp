@@ -9,6 +9,8 @@
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "kernels/clearview_extract.h"
+#include "kernels/ray_skip.h"
+#include "render/renderer.h"
 #include "visopt/error.h"
 #include "visopt/exec.h"
 #include "visopt/frustum.h"
@@ -30,11 +32,42 @@ glm::vec3 toDisplay(glm::vec3 c) {
   return {enc(c.r), enc(c.g), enc(c.b)};
 }
 
-ClearViewSurfaceField fieldOf(const ClearViewSurfaceSource& s) {
+// The empty-space flags of an isosurface (kernels/clearview_extract.h): a block is empty when
+// the field's maximum over it and its 26 neighbours lies below the isovalue.
+DeviceBuffer<uint8_t> emptyBlocks(const Field3D& field, float iso, glm::ivec3& blocks) {
+  const DeviceBuffer<glm::vec2> range = computeBlockRange(field);  // kRaySkipBlock^3 blocks
+  static_assert(kRaySkipBlock == kClearViewBlock, "ClearView reuses the renderer's block ranges");
+  blocks = raySkipBlocks(field.grid().dims);
+  const glm::ivec3 nb = blocks;
+  const int64_t n = int64_t(nb.x) * nb.y * nb.z;
+  DeviceBuffer<uint8_t> empty(static_cast<size_t>(n));
+  const glm::vec2* r = range.data();
+  uint8_t* out = empty.data();
+  exec::parallelFor("clearview: empty blocks", n, [=] VISOPT_HD(int64_t block) {
+    const int bx = int(block % nb.x), by = int((block / nb.x) % nb.y),
+              bz = int(block / (int64_t(nb.x) * nb.y));
+    float hi = -3.0e38f;
+    for (int k = bz - 1; k <= bz + 1; ++k)
+      for (int j = by - 1; j <= by + 1; ++j)
+        for (int i = bx - 1; i <= bx + 1; ++i) {
+          if (i < 0 || j < 0 || k < 0 || i >= nb.x || j >= nb.y || k >= nb.z) continue;
+          const float h = r[(int64_t(k) * nb.y + j) * nb.x + i].y;
+          hi = h > hi ? h : hi;
+        }
+    out[block] = hi < iso ? 1 : 0;
+  });
+  return empty;
+}
+
+ClearViewSurfaceField fieldOf(const ClearViewSurfaceSource& s, DeviceBuffer<uint8_t>& empty) {
   ClearViewSurfaceField f;
   f.field = FieldView(*s.field);
   f.iso = s.iso;
   f.sign = s.sign;
+  if (s.sign > 0.f) {  // an isosurface; an SDF is sphere traced instead
+    empty = emptyBlocks(*s.field, s.iso, f.blocks);
+    f.empty = empty.data();
+  }
   return f;
 }
 
@@ -87,8 +120,9 @@ void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>&
   ClearViewExtractParams p;
   p.camera = FrustumMap(FrustumGrid::forCamera(camera, width, height, grid.worldBounds(), 1, 1.f));
   p.volume = GridMap(grid);
-  p.context = fieldOf(context);
-  p.focus = fieldOf(focus);
+  DeviceBuffer<uint8_t> contextEmpty, focusEmpty;
+  p.context = fieldOf(context, contextEmpty);
+  p.focus = fieldOf(focus, focusEmpty);
   p.step = 0.5f * grid.minSpacing();
   const glm::vec3 diagonal = grid.worldBounds().hi - grid.worldBounds().lo;
   p.maxNormalDistance = 0.25f * glm::length(diagonal);

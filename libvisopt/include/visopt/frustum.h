@@ -23,6 +23,9 @@ struct FrustumGrid {
   glm::ivec3 dims{1};
   float sNear = 0.f, sFar = 1.f;
 
+  // Equal members: the same rays and cells (what a cache of a frustum's fields compares).
+  bool operator==(const FrustumGrid&) const = default;
+
   float depthStep() const { return (sFar - sNear) / static_cast<float>(dims.z); }
   // g: world -> continuous grid coordinates.
   glm::vec3 toGrid(glm::vec3 world) const;

@@ -160,15 +160,8 @@ struct ImportanceBehindInputs {
   uint64_t importanceRevision = 0;
 };
 
-bool sameFrustum(const FrustumGrid& a, const FrustumGrid& b) {
-  return a.eye == b.eye && a.right == b.right && a.up == b.up && a.forward == b.forward &&
-         a.tanHalfFovX == b.tanHalfFovX && a.tanHalfFovY == b.tanHalfFovY && a.dims == b.dims &&
-         a.sNear == b.sNear && a.sFar == b.sFar;
-}
-
 bool operator==(const ImportanceBehindInputs& a, const ImportanceBehindInputs& b) {
-  return sameFrustum(a.view, b.view) && sameFrustum(a.light, b.light) &&
-         a.importanceRevision == b.importanceRevision;
+  return a.view == b.view && a.light == b.light && a.importanceRevision == b.importanceRevision;
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "kernels/surface_render.h"
 #include "kernels/transmittance_scan.h"
 #include "kernels/volume_extinction.h"
+#include "render/abandonable_bands.h"
 #include "visopt/error.h"
 
 namespace visopt {
@@ -146,15 +147,11 @@ bool computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
     exec::parallelFor("light transmittance", rays, scan);
     return true;
   }
-  // Bands of rays, so that a newer camera need not wait for the whole grid.
-  constexpr int64_t kBands = 16;
-  const int64_t band = (rays + kBands - 1) / kBands;
-  for (int64_t first = 0; first < rays; first += band) {
-    if (abandon()) return false;
-    exec::parallelFor("light transmittance", std::min(band, rays - first),
+  // 16 bands of rays, so that a newer camera need not wait for the whole grid.
+  return launchInBands(rays, 16, 1, abandon, [&](int64_t first, int64_t count) {
+    exec::parallelFor("light transmittance", count,
                       [=] VISOPT_HD(int64_t ray) { scan(first + ray); });
-  }
-  return true;
+  });
 }
 
 Image renderImage(const RenderScene& scene, const RenderSettings& settings, RenderStats* stats,
@@ -231,16 +228,14 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   if (!abandon) {
     samples = exec::reduce("render", items, int64_t(0), kernel, sum);
   } else {
-    // Bands of whole ray tiles, so that a newer camera need not wait for the whole frame.
-    constexpr int64_t kBands = 32;
-    const int64_t tile = int64_t(kRayTile) * kRayTile;
-    const int64_t band = (items / tile + kBands - 1) / kBands * tile;
-    for (int64_t first = 0; first < items; first += band) {
-      if (abandon()) return Image();
-      samples += exec::reduce(
-          "render", std::min(band, items - first), int64_t(0),
-          [=] VISOPT_HD(int64_t item) { return kernel(first + item); }, sum);
-    }
+    // 32 bands of whole ray tiles, so that a newer camera need not wait for the whole frame.
+    const bool done = launchInBands(
+        items, 32, int64_t(kRayTile) * kRayTile, abandon, [&](int64_t first, int64_t count) {
+          samples += exec::reduce(
+              "render", count, int64_t(0),
+              [=] VISOPT_HD(int64_t item) { return kernel(first + item); }, sum);
+        });
+    if (!done) return Image();
   }
 
   Image image(w, h);

@@ -227,3 +227,24 @@ TEST(CliClearView, CompareShowsClearViewAsTheFifthPanel) {
   EXPECT_NE(lines[0].find("--clearview"), std::string::npos) << lines[0];
   EXPECT_FALSE(fs::exists(tmp("compare-bad.png")));
 }
+
+// `visopt optimize --importance hotspot:X,Y,Z,R`: the hotspot as paper 000's importance.
+TEST(CliClearView, OptimizeTakesTheHotspotAsItsImportance) {
+  const Result r =
+      run("optimize --scene builtin:shepp-logan --resolution 48 "
+          "--importance hotspot:10,20,5,30 --iterations 5 --levels 1 --out " +
+          tmp("hotspot.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["final"]["visibility_view"].get<double>(),
+            j["initial"]["visibility_view"].get<double>());
+  for (const char* bad : {"hotspot:10,20,5", "hotspot:10,20,nan,3", "hotspot:1,2,3,0",
+                          "hotspot:1,2,3,-4", "hotspot:"}) {
+    const Result b = run(std::string("optimize --scene builtin:shepp-logan --resolution 32 ") +
+                         "--importance " + bad + " --out " + tmp("hotspot-bad.png"));
+    EXPECT_EQ(b.code, 1) << bad << ": " << b.err;
+    const std::vector<std::string> lines = errorLines(b.err);
+    ASSERT_EQ(lines.size(), 1u) << b.err;
+    EXPECT_NE(lines[0].find("--importance"), std::string::npos) << lines[0];
+  }
+}

@@ -208,7 +208,7 @@ TEST(Session, DefaultsAreNotWritten) {
   EXPECT_EQ(doc["data"]["builtin"], "marschner-lobb");
   EXPECT_EQ(doc["data"]["resolution"], 16);
   for (const char* key : {"extinction", "levelSet", "lens", "render", "frozen", "worldMask",
-                          "precision", "contextSurfaces"})
+                          "precision", "contextSurfaces", "clearView"})
     EXPECT_FALSE(doc.contains(key)) << key;
   EXPECT_TRUE(doc.contains("camera"));
 }
@@ -316,6 +316,200 @@ TEST(Session, OlderVersionsLoadThroughTheMigrations) {
   for (const auto& w : report.warnings) ADD_FAILURE() << w;
   EXPECT_EQ(engine.contextSurfaces().size(), 1u);
   EXPECT_EQ(engine.camera().fovYDegrees, 25.f);
+}
+
+// The ClearView hotspot's settings (version 4): every stored member comes back; width, height and
+// the focus pixel belong to the view and are not stored; only the layers and non-defaults are
+// written.
+TEST(Session, ClearViewSettingsRoundTripEveryField) {
+  const fs::path dir = freshDir("clearview");
+  const std::string path = (dir / "hotspot.visopt-session").string();
+  Engine engine;
+  engine.loadBuiltinScene("marschner-lobb", 16);
+  Session saved = captureSession(engine, {}, path);
+  EXPECT_FALSE(saved.clearView);  // no Engine state: the caller sets it
+
+  ClearViewSettings c;
+  c.width = 300;  // not stored
+  c.height = 200;
+  c.focusPixel = {12.f, 34.f};
+  c.context = {ClearViewLayerKind::Isosurface, 0.37, 0};
+  c.focus = {ClearViewLayerKind::ContextSurface, 0.0, 2};
+  c.volumeLayer = true;
+  c.measure = ClearViewMeasure::ViewDistance;
+  c.contextShader = ClearViewShader::CoolWarm;
+  c.focusShader = ClearViewShader::Diffuse;
+  c.size = 12.25f;
+  c.weight = 0.3f;
+  c.distanceScale = 4.5f;
+  c.border = false;
+  c.ambient = 0.4f;
+  c.headlight = false;
+  c.contextColor = {0.1f, 0.2f, 0.3f};
+  c.focusColor = {0.4f, 0.5f, 0.6f};
+  c.background = {0.7f, 0.8f, 0.9f};
+  // Every member differs from the default (so a member left out of the format would show).
+  const ClearViewSettings d;
+  ASSERT_NE(c.context, d.context);
+  ASSERT_NE(c.focus, d.focus);
+  ASSERT_NE(c.contextColor, d.contextColor);
+  ASSERT_NE(c.focusColor, d.focusColor);
+  ASSERT_NE(c.background, d.background);
+  saved.clearView = c;
+  saveSession(saved, path);
+
+  const Session loaded = loadSession(path);
+  ASSERT_TRUE(loaded.clearView);
+  const ClearViewSettings& r = *loaded.clearView;
+  EXPECT_EQ(r.context, c.context);
+  EXPECT_EQ(r.focus, c.focus);
+  EXPECT_EQ(r.volumeLayer, c.volumeLayer);
+  EXPECT_EQ(r.measure, c.measure);
+  EXPECT_EQ(r.contextShader, c.contextShader);
+  EXPECT_EQ(r.focusShader, c.focusShader);
+  EXPECT_EQ(r.size, c.size);
+  EXPECT_EQ(r.weight, c.weight);
+  EXPECT_EQ(r.distanceScale, c.distanceScale);
+  EXPECT_EQ(r.border, c.border);
+  EXPECT_EQ(r.ambient, c.ambient);
+  EXPECT_EQ(r.headlight, c.headlight);
+  EXPECT_EQ(r.contextColor, c.contextColor);
+  EXPECT_EQ(r.focusColor, c.focusColor);
+  EXPECT_EQ(r.background, c.background);
+  EXPECT_EQ(r.width, d.width);
+  EXPECT_EQ(r.height, d.height);
+  EXPECT_EQ(r.focusPixel, d.focusPixel);
+  EXPECT_EQ(readText(path), sessionToJson(loaded, path));
+  const auto doc = nlohmann::json::parse(readText(path));
+  EXPECT_EQ(doc["version"], 4);
+  EXPECT_EQ(doc["clearView"]["context"],
+            nlohmann::json::parse(R"({"kind":"iso","isovalue":0.37})"));
+  EXPECT_EQ(doc["clearView"]["focus"], nlohmann::json::parse(R"({"kind":"surface","surface":2})"));
+  EXPECT_EQ(doc["clearView"]["measure"], "view-distance");
+  EXPECT_EQ(doc["clearView"]["contextShader"], "cool-warm");
+  for (const char* key : {"width", "height", "focusPixel"})
+    EXPECT_FALSE(doc["clearView"].contains(key)) << key;
+
+  // The defaults but for the layers: only the layers are written (the importance layer too).
+  ClearViewSettings plain;
+  plain.context = {ClearViewLayerKind::ContextSurface, 0.0, 0};
+  plain.focus = {ClearViewLayerKind::Importance, 0.75, 0};
+  saved.clearView = plain;
+  saveSession(saved, path);
+  const auto plainDoc = nlohmann::json::parse(readText(path));
+  EXPECT_EQ(plainDoc["clearView"],
+            nlohmann::json::parse(R"({"context":{"kind":"surface","surface":0},)"
+                                  R"("focus":{"kind":"importance","isovalue":0.75}})"));
+  const Session plainLoaded = loadSession(path);
+  ASSERT_TRUE(plainLoaded.clearView);
+  EXPECT_EQ(plainLoaded.clearView->context, plain.context);
+  EXPECT_EQ(plainLoaded.clearView->focus, plain.focus);
+  EXPECT_EQ(plainLoaded.clearView->measure, d.measure);
+  EXPECT_EQ(plainLoaded.clearView->size, d.size);
+
+  // The engine applies such a session as before (the settings are the caller's).
+  Engine restored;
+  const SessionLoadReport report = applySession(restored, loaded, path);
+  EXPECT_TRUE(report.sceneLoaded);
+  for (const auto& w : report.warnings) ADD_FAILURE() << w;
+}
+
+// Version 3 had no hotspot settings: such a file loads with none (the scene's defaults), and a
+// "clearView" that a version-3 reader would have ignored is not taken for settings.
+TEST(Session, VersionThreeLoadsWithoutHotspotSettings) {
+  const std::string v3 =
+      R"({"format":"visopt-session","version":3,"data":{"builtin":"marschner-lobb","resolution":16},)"
+      R"("extinction":{"q":11},"clearView":{"weight":"not from visopt"}})";
+  const Session s = sessionFromJson(v3, "v3.json");
+  EXPECT_EQ(s.version, 3);
+  EXPECT_FALSE(s.clearView);
+  EXPECT_EQ(s.extinction.q, 11.f);
+  const auto written = nlohmann::json::parse(sessionToJson(s));
+  EXPECT_EQ(written["version"], kSessionFormatVersion);
+  EXPECT_FALSE(written.contains("clearView"));
+  Engine engine;
+  const SessionLoadReport report = applySession(engine, s, {});
+  EXPECT_TRUE(report.sceneLoaded);
+  for (const auto& w : report.warnings) ADD_FAILURE() << w;
+}
+
+TEST(Session, BadHotspotSettingsAreRefusedNamingTheFile) {
+  const fs::path dir = freshDir("clearview-bad");
+  const std::string head =
+      R"({"format":"visopt-session","version":4,"data":{"builtin":"marschner-lobb"},"clearView":)";
+  const std::string layers =
+      R"("context":{"kind":"surface","surface":0},"focus":{"kind":"importance","isovalue":0.5})";
+  auto check = [&](const std::string& name, const std::string& clearView, const char* needle) {
+    const std::string path = (dir / name).string();
+    writeText(path, head + clearView + "}");
+    const std::string msg = expectBadInput([&] { loadSession(path); }, path);
+    EXPECT_NE(msg.find(needle), std::string::npos) << msg;
+  };
+  // The good one loads (so each failure below is the one value's).
+  writeText(dir / "good.json", head + "{" + layers + R"(,"weight":2})" + "}");
+  EXPECT_EQ(loadSession((dir / "good.json").string()).clearView->weight, 2.f);
+
+  check("notobject.json", "[1]", "clearView: expected an object");
+  check("nofocus.json", R"({"context":{"kind":"surface","surface":0}})",
+        "clearView: missing \"focus\"");
+  check("kind.json", R"({"context":{"kind":"mesh"},"focus":{"kind":"importance","isovalue":1}})",
+        "clearView.context.kind: expected \"iso\", \"surface\" or \"importance\"");
+  check("noiso.json", R"({"context":{"kind":"iso"},"focus":{"kind":"importance","isovalue":1}})",
+        "clearView.context: missing \"isovalue\"");
+  check(
+      "level.json",
+      R"({"context":{"kind":"surface","surface":0},"focus":{"kind":"importance","isovalue":1.5}})",
+      "clearView.focus.isovalue: an importance level must lie in (0, 1]");
+  check("index.json",
+        R"({"context":{"kind":"surface","surface":-1},"focus":{"kind":"importance","isovalue":1}})",
+        "clearView.context.surface: must be a context-surface index >= 0");
+  check("weight.json", "{" + layers + R"(,"weight":-1})", "clearView.weight: must be >= 0");
+  check("ambient.json", "{" + layers + R"(,"ambient":2})", "clearView.ambient: must lie in [0, 1]");
+  check("size.json", "{" + layers + R"(,"size":"big"})", "clearView.size: expected a number");
+  check("negsize.json", "{" + layers + R"(,"size":-3})", "clearView.size: must be >= 0");
+  check("scale.json", "{" + layers + R"(,"distanceScale":-1})", "clearView.distanceScale");
+  check("border.json", "{" + layers + R"(,"border":1})",
+        "clearView.border: expected true or false");
+  check("measure.json", "{" + layers + R"(,"measure":"depth"})",
+        "clearView.measure: unknown \"depth\" (expected \"curvature\", \"distance\", "
+        "\"view-distance\")");
+  check("shader.json", "{" + layers + R"(,"focusShader":"metal"})",
+        "clearView.focusShader: unknown \"metal\"");
+  check("colour.json", "{" + layers + R"(,"background":[0,-1,0]})",
+        "clearView.background: colour components must be >= 0");
+  check("nan.json", "{" + layers + R"(,"weight":1e999})", "invalid JSON");
+}
+
+// The importance as a hotspot ball (Engine::setImportanceHotspot) is stored by its centre and
+// radius and rebuilt from them.
+TEST(Session, HotspotImportanceRoundTrips) {
+  const fs::path dir = freshDir("hotspot-importance");
+  const std::string path = (dir / "s.json").string();
+  Engine engine;
+  engine.loadBuiltinScene("marschner-lobb", 16);
+  engine.setImportanceHotspot({0.1f, -0.2f, 0.05f}, 0.4f);
+  saveSession(captureSession(engine, {}, path), path);
+  const auto doc = nlohmann::json::parse(readText(path));
+  EXPECT_EQ(doc["importance"]["kind"], "hotspot");
+  const Session loaded = loadSession(path);
+  EXPECT_EQ(loaded.importance.kind, ImportanceKind::Hotspot);
+  EXPECT_EQ(loaded.importance.hotspotCentre, glm::vec3(0.1f, -0.2f, 0.05f));
+  EXPECT_EQ(loaded.importance.hotspotRadius, 0.4f);
+  Engine restored;
+  const SessionLoadReport report = applySession(restored, loaded, path);
+  for (const auto& w : report.warnings) ADD_FAILURE() << w;
+  ASSERT_TRUE(restored.hasImportance());
+  EXPECT_EQ(restored.importanceSource().kind, ImportanceKind::Hotspot);
+  EXPECT_EQ(restored.importanceSource().hotspotRadius, 0.4f);
+  const Field3D& a = *engine.importance();
+  const Field3D& b = *restored.importance();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a.get(i), b.get(i)) << i;
+  const std::string bad = (dir / "bad.json").string();
+  writeText(bad, R"({"format":"visopt-session","version":4,"data":{"builtin":"a"},)"
+                 R"("importance":{"kind":"hotspot","centre":[0,0,0],"radius":0}})");
+  const std::string msg = expectBadInput([&] { loadSession(bad); }, bad);
+  EXPECT_NE(msg.find("importance.radius: must be positive"), std::string::npos) << msg;
 }
 
 TEST(Session, DamagedFilesGiveOneLineBadInputAndLeaveTheEngineUsable) {

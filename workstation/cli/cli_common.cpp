@@ -9,8 +9,6 @@
 
 namespace visopt::cli {
 
-namespace {
-
 std::vector<float> parseFloats(const std::string& text, char sep, const std::string& what) {
   std::vector<float> out;
   std::stringstream ss(text);
@@ -28,8 +26,6 @@ std::vector<float> parseFloats(const std::string& text, char sep, const std::str
   }
   return out;
 }
-
-}  // namespace
 
 glm::ivec2 parseSize(const std::string& text) {
   auto v = parseFloats(text, 'x', "--size");

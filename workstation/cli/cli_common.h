@@ -16,6 +16,8 @@ enum ExitCode { kOk = 0, kUsage = 1, kBadInput = 2, kFailure = 3 };
 
 // "WxH" -> (W, H); throws Error(Usage).
 glm::ivec2 parseSize(const std::string& text);
+// Finite numbers separated by `sep`; throws Error(Usage) naming `what`.
+std::vector<float> parseFloats(const std::string& text, char sep, const std::string& what);
 // "A,B,C" -> three floats; throws Error(Usage) naming `what`.
 glm::vec3 parseTriple(const std::string& text, const std::string& what);
 

@@ -93,8 +93,9 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--importance", o->importance,
                  "Importance g in [0,1]: preset:NAME (the importance a transfer-function preset "
                  "is made for, the default with --tf preset:ct-skin-bone or preset:ct-bone: "
-                 "bone), a curve JSON {\"points\":[[value,g],...]} or a volume file on the same "
-                 "grid");
+                 "bone), hotspot:X,Y,Z,R (ClearView's hotspot as the importance: a smooth ball of "
+                 "radius R about the world point X,Y,Z, 1 within R/2), a curve JSON "
+                 "{\"points\":[[value,g],...]} or a volume file on the same grid");
   app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST (degrees, degrees, bounding radii)")
       ->default_str("the scene's view");
   app.add_option("--light", o->light, "Point light on an orbit AZ,EL,DIST")
@@ -202,6 +203,15 @@ Runner addOptimizeCommand(CLI::App& app) {
                                           ": this preset carries no importance (the CT presets "
                                           "ct-skin-bone and ct-bone do)");
       if (!curve.empty()) engine.setImportanceCurve(curve, "preset:" + importancePreset);
+    } else if (o->importance.rfind("hotspot:", 0) == 0) {
+      const std::vector<float> v = parseFloats(o->importance.substr(8), ',', "--importance");
+      if (v.size() != 4)
+        throw Error(ErrorKind::Usage,
+                    "--importance " + o->importance + ": expected hotspot:X,Y,Z,R (world units)");
+      if (!(v[3] > 0.f))
+        throw Error(ErrorKind::Usage,
+                    "--importance " + o->importance + ": the radius R must be positive");
+      engine.setImportanceHotspot({v[0], v[1], v[2]}, v[3]);
     } else if (!o->importance.empty()) {
       engine.loadImportance(o->importance);
     }

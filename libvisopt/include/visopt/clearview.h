@@ -47,7 +47,8 @@ struct ClearViewSettings {
   ClearViewLayer focus{ClearViewLayerKind::Importance, 0.5, 0};  // the opaque focus surface
   // Also a volume context layer: all matter in front of the first context or focus surface,
   // composited front to back with the transfer function (emission-absorption: the albedo as
-  // emitted colour, no shading), made transparent around the focus point like the surface.
+  // emitted colour, no shading), made transparent around the focus point like the surface but
+  // kept where its colour changes from pixel to pixel (the paper's high-pass filter).
   bool volumeLayer = false;
 
   ClearViewMeasure measure = ClearViewMeasure::Curvature;

@@ -63,6 +63,11 @@ class Engine {
   // A JSON curve file ({"points": [[value, g], ...]} or a visopt transfer function whose opacity
   // is read as g) or a volume file on the same grid with values in [0, 1].
   void loadImportance(const std::string& path);
+  // ClearView's hotspot as the importance (beyond both papers): g = 1 within radius / 2 of
+  // `centre` (world units), falling smoothly (C1) to 0 at `radius`, so that the optimisation
+  // opens the context where the user points. Usage error for a non-finite centre or a radius
+  // that is not positive and finite.
+  void setImportanceHotspot(glm::vec3 centre, float radius);
   bool hasImportance() const;
   const Field3D* importance() const;
   // Where the importance came from, so a session can rebuild it.
@@ -71,6 +76,8 @@ class Engine {
     Kind kind = Kind::None;
     std::vector<glm::dvec2> curve;  // Kind::Curve: (value, g) points in data units
     std::string path;               // Kind::Volume: the file
+    glm::vec3 hotspotCentre{0.f};   // Kind::Hotspot: world units
+    float hotspotRadius = 0.f;      // Kind::Hotspot: world units
   };
   const ImportanceSource& importanceSource() const;
 

@@ -4,9 +4,10 @@
 
 namespace visopt {
 
-enum class ImportanceKind { None, Scene, Curve, Volume };
+// Hotspot: a smooth ball about a world point (Engine::setImportanceHotspot).
+enum class ImportanceKind { None, Scene, Curve, Volume, Hotspot };
 
-// "none", "scene", "curve" or "volume": the names the session format uses.
+// "none", "scene", "curve", "volume" or "hotspot": the names the session format uses.
 const char* toString(ImportanceKind kind);
 
 }  // namespace visopt

@@ -22,6 +22,7 @@
 
 #include "visopt/bit_mask.h"
 #include "visopt/camera.h"
+#include "visopt/clearview.h"
 #include "visopt/engine.h"
 #include "visopt/importance_kind.h"
 #include "visopt/level_set.h"
@@ -37,7 +38,8 @@ namespace visopt {
 //   1: camera stored as an orbit {"target", "azimuth", "elevation", "distance", "fovY"}
 //   2: camera stored as {"eye", "target", "up", "fovY"}
 //   3: "tf" renamed "transferFunction", "surfaces" renamed "contextSurfaces"
-inline constexpr int kSessionFormatVersion = 3;
+//   4: "clearView" (the ClearView hotspot's settings) and the importance kind "hotspot"
+inline constexpr int kSessionFormatVersion = 4;
 
 // ---- data references ----------------------------------------------------------------------
 
@@ -102,6 +104,8 @@ struct SessionImportance {
   Kind kind = Kind::None;
   std::vector<glm::dvec2> curve;  // Curve: (value, g) in data units
   DataReference volume;           // Volume: the importance file
+  glm::vec3 hotspotCentre{0.f};   // Hotspot: Engine::setImportanceHotspot's, world units
+  float hotspotRadius = 0.f;
 };
 
 struct SessionSurface {
@@ -127,6 +131,12 @@ struct Session {
   RenderSettings render;  // image size, deviation view, ... (the engine does not hold them)
   bool frozen = false;
   std::optional<SessionMask> worldMask;
+  // The ClearView hotspot's settings (the workstation's Hotspot tool; visopt/clearview.h): all of
+  // ClearViewSettings but width, height and focusPixel, which belong to the view and are not
+  // stored (they read back as the defaults). Empty: none were set, the scene's defaults apply
+  // (docs/clearview.md). They are no Engine state: captureSession leaves them empty and
+  // applySession does not use them; the caller sets and reads them.
+  std::optional<ClearViewSettings> clearView;
 };
 
 // Reads the engine's state. `render` is the caller's render settings (the workstation's view).

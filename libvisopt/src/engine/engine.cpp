@@ -618,6 +618,20 @@ void Engine::loadImportance(const std::string& path) {
   ++impl_->importanceRevision;
 }
 
+void Engine::setImportanceHotspot(glm::vec3 centre, float radius) {
+  if (!impl_->volume) throw Error(ErrorKind::Usage, "load a volume before its importance");
+  if (!std::isfinite(centre.x) || !std::isfinite(centre.y) || !std::isfinite(centre.z))
+    throw Error(ErrorKind::Usage, "the hotspot's centre must be finite");
+  if (!std::isfinite(radius) || !(radius > 0.f))
+    throw Error(ErrorKind::Usage, "the hotspot's radius must be positive and finite");
+  Field3D g =
+      importanceFromHotspot(*impl_->volume, centre, radius, impl_->precision, &impl_->ledger);
+  impl_->importance.reset();
+  impl_->importance.emplace(std::move(g));
+  impl_->importanceSource = {ImportanceSource::Kind::Hotspot, {}, {}, centre, radius};
+  ++impl_->importanceRevision;
+}
+
 const Engine::ImportanceSource& Engine::importanceSource() const {
   return impl_->importanceSource;
 }

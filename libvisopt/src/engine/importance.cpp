@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/field_view.h"
+#include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "io/file_util.h"
 #include "visopt/error.h"
@@ -76,6 +77,21 @@ Field3D importanceFromNormalizedCurve(const Volume& volume, const std::vector<gl
   std::vector<glm::dvec2> pts;
   for (const auto& p : points) pts.emplace_back(volume.toValue(p.x), p.y);
   return importanceFromCurve(volume, pts, "scene importance curve", precision, ledger);
+}
+
+Field3D importanceFromHotspot(const Volume& volume, glm::vec3 centre, float radius,
+                              Precision precision, MemoryLedger* ledger) {
+  Field3D g("importance", volume.grid(), precision, ledger);
+  FieldView out(g);
+  const GridMap map(volume.grid());
+  const float inner = 0.5f * radius;
+  exec::parallelFor("importance: hotspot", int64_t(g.size()), [=](int64_t v) {
+    const VoxelIjk ijk = map.ijk(v);
+    const float d = glm::length(map.toWorld(glm::vec3(ijk.i, ijk.j, ijk.k)) - centre);
+    const float x = std::clamp((radius - d) / (radius - inner), 0.f, 1.f);  // 1 inside, 0 out
+    out.store(size_t(v), x * x * (3.f - 2.f * x));
+  });
+  return g;
 }
 
 bool isCurveFile(const std::string& path) {

@@ -19,6 +19,10 @@ Field3D importanceFromCurve(const Volume& volume, const std::vector<glm::dvec2>&
 // The same over normalised values t in [0, 1] (the built-in scenes' curves).
 Field3D importanceFromNormalizedCurve(const Volume& volume, const std::vector<glm::vec2>& points,
                                       Precision precision, MemoryLedger* ledger);
+// A smooth ball: g = 1 within radius / 2 of `centre`, 1 - smoothstep over [radius / 2, radius],
+// 0 beyond (world units).
+Field3D importanceFromHotspot(const Volume& volume, glm::vec3 centre, float radius,
+                              Precision precision, MemoryLedger* ledger);
 // True for .json files.
 bool isCurveFile(const std::string& path);
 // {"points": [[value, g], ...]} or a visopt transfer-function JSON (its opacity read as g).

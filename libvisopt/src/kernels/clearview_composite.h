@@ -71,6 +71,22 @@ VISOPT_HD inline float clearViewCurvature(const glm::vec3* normal, const float* 
   return sum;
 }
 
+// The volume layer's high-pass (§3.1: "an image-based high-pass filter to enhance regions
+// exhibiting high color gradients"): the summed distances of the pixel's premultiplied colour to
+// its 4 neighbours', the volume layer's counterpart of the surface curvature (the paper names
+// the filter, not its kernel; this is the same umbrella form).
+VISOPT_HD inline float clearViewColorEdges(const glm::vec4* volume, int w, int h, int x, int y) {
+  const glm::vec3 c = glm::vec3(volume[int64_t(y) * w + x]);
+  float sum = 0.f;
+  const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+  for (int k = 0; k < 4; ++k) {
+    const int qx = x + dx[k], qy = y + dy[k];
+    if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+    sum += glm::length(c - glm::vec3(volume[int64_t(qy) * w + qx]));
+  }
+  return sum;
+}
+
 // The context's opacity at a pixel with a context hit (the measure's term and the distance
 // term), before the border.
 VISOPT_HD inline float clearViewContextOpacity(const ClearViewCompositeParams& p, int x, int y) {
@@ -126,7 +142,11 @@ struct ClearViewCompositeKernel {
     }
     if (L.volume) {  // premultiplied, made transparent about the focus point like the surface
       const glm::vec4 v = L.volume[pixel];
-      color = near * glm::vec3(v) + (1.f - near * v.w) * color;
+      const float keep =
+          p.hasFocusPoint ? cvSaturate(maxOf(near, p.weight * clearViewColorEdges(L.volume, p.width,
+                                                                                  p.height, x, y)))
+                          : 1.f;
+      color = keep * glm::vec3(v) + (1.f - keep * v.w) * color;
     }
     p.out[pixel] = glm::vec3(toLinear(color.r), toLinear(color.g), toLinear(color.b));
   }

@@ -204,6 +204,12 @@ SessionLoadReport applySession(Engine& engine, const Session& session,
       report.data.push_back(d);
       break;
     }
+    case SessionImportance::Kind::Hotspot:
+      warnIfFails("importance", [&] {
+        engine.setImportanceHotspot(session.importance.hotspotCentre,
+                                    session.importance.hotspotRadius);
+      });
+      break;
   }
 
   // Level-set settings first: building a surface's SDF uses them.

@@ -31,6 +31,10 @@ Session captureSession(const Engine& engine, const RenderSettings& render,
   if (imp.kind == ImportanceKind::Curve) s.importance.curve = imp.curve;
   if (imp.kind == ImportanceKind::Volume)
     s.importance.volume = makeDataReference(imp.path, sessionPath);
+  if (imp.kind == ImportanceKind::Hotspot) {
+    s.importance.hotspotCentre = imp.hotspotCentre;
+    s.importance.hotspotRadius = imp.hotspotRadius;
+  }
 
   for (const ContextSurfaceSpec& spec : engine.contextSurfaces()) {
     SessionSurface surface{spec, {}};

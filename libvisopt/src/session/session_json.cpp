@@ -1,20 +1,27 @@
 // Session <-> JSON text of the current format version (older versions go through migrate()).
 //
-//   {"format": "visopt-session", "version": 3,
+//   {"format": "visopt-session", "version": 4,
 //    "data": {"builtin": "shepp-logan", "resolution": 64}          (or {"volume": REF})
 //    "precision": "fp16", "transferFunction": {...}, "importance": {"kind": "curve", ...},
 //    "contextSurfaces": [{"source": "mesh:...", "file": REF, ...}], "extinction": {...},
 //    "levelSet": {...}, "camera": {...}, "light": {...}, "lens": {...}, "render": {...},
-//    "frozen": true, "worldMask": {"dims": [..], "encoding": "bits-lsb+zstd+base64", ...}}
+//    "frozen": true, "worldMask": {"dims": [..], "encoding": "bits-lsb+zstd+base64", ...},
+//    "clearView": {"context": LAYER, "focus": LAYER, "measure": "distance", "size": 12, ...}}
 //   REF = {"absolute": "/data/ct.nii.gz", "relative": "../data/ct.nii.gz", "sha256": .., "bytes":
 //   ..}
+//   LAYER = {"kind": "iso", "isovalue": -400} | {"kind": "surface", "surface": 0}
+//         | {"kind": "importance", "isovalue": 0.5}
 // Settings sections hold only values that differ from the defaults and are left out when empty.
+// "clearView" is there when the session has hotspot settings at all; its two layers are always
+// written (their default is the scene's: a context surface, the importance), everything else
+// only where it differs from ClearViewSettings{}.
 #include <nlohmann/json.hpp>
 
 #include "session/json_fields.h"
 #include "session/mask_codec.h"
 #include "session/session_migrate.h"
 #include "session/settings_tables.h"
+#include "visopt/clearview.h"
 #include "visopt/error.h"
 #include "visopt/session.h"
 
@@ -91,6 +98,110 @@ SessionMask maskFromJson(const json& j, const Where& where) {
   return m;
 }
 
+// ---- ClearView ----
+
+OrderedJson layerToJson(const ClearViewLayer& layer) {
+  OrderedJson j = {{"kind", toString(layer.kind)}};
+  if (layer.kind == ClearViewLayerKind::ContextSurface)
+    j["surface"] = layer.surface;
+  else
+    j["isovalue"] = layer.isovalue;
+  return j;
+}
+
+// Only the member the kind uses is read; the other keeps its default, so a layer compares equal
+// to the one written.
+ClearViewLayer layerFromJson(const json& j, const Where& where) {
+  session::expectObject(j, where);
+  std::string kind;
+  session::readRequired(j, "kind", kind, where);
+  ClearViewLayer layer;
+  if (kind == toString(ClearViewLayerKind::Isosurface)) {
+    layer.kind = ClearViewLayerKind::Isosurface;
+    session::readRequired(j, "isovalue", layer.isovalue, where);
+  } else if (kind == toString(ClearViewLayerKind::ContextSurface)) {
+    layer.kind = ClearViewLayerKind::ContextSurface;
+    session::readRequired(j, "surface", layer.surface, where);
+    if (layer.surface < 0) where.key("surface").fail("must be a context-surface index >= 0");
+  } else if (kind == toString(ClearViewLayerKind::Importance)) {
+    layer.kind = ClearViewLayerKind::Importance;
+    session::readRequired(j, "isovalue", layer.isovalue, where);
+    if (!(layer.isovalue > 0.0 && layer.isovalue <= 1.0))
+      where.key("isovalue").fail("an importance level must lie in (0, 1]");
+  } else {
+    where.key("kind").fail("expected \"iso\", \"surface\" or \"importance\"");
+  }
+  return layer;
+}
+
+// The enum value whose toString is `name`, or a failure naming the choices.
+template <class E, size_t N>
+E enumFromJson(const json& j, const E (&values)[N], const Where& where) {
+  std::string name;
+  session::readValue(j, name, where);
+  std::string choices;
+  for (E v : values) {
+    if (name == toString(v)) return v;
+    choices += (choices.empty() ? "\"" : ", \"") + std::string(toString(v)) + "\"";
+  }
+  where.fail("unknown \"" + name + "\" (expected " + choices + ")");
+}
+
+constexpr ClearViewMeasure kMeasures[] = {ClearViewMeasure::Curvature, ClearViewMeasure::Distance,
+                                          ClearViewMeasure::ViewDistance};
+constexpr ClearViewShader kShaders[] = {ClearViewShader::Diffuse, ClearViewShader::CoolWarm,
+                                        ClearViewShader::Skin, ClearViewShader::Bone};
+
+OrderedJson clearViewToJson(const ClearViewSettings& c) {
+  const ClearViewSettings defaults;
+  OrderedJson j = {{"context", layerToJson(c.context)}, {"focus", layerToJson(c.focus)}};
+  if (c.measure != defaults.measure) j["measure"] = toString(c.measure);
+  if (c.contextShader != defaults.contextShader) j["contextShader"] = toString(c.contextShader);
+  if (c.focusShader != defaults.focusShader) j["focusShader"] = toString(c.focusShader);
+  j.update(session::clearViewFields().write(c));
+  return j;
+}
+
+ClearViewSettings clearViewFromJson(const json& j, const Where& where) {
+  session::expectObject(j, where);
+  ClearViewSettings c;
+  auto layer = [&](const char* key) {
+    auto it = j.find(key);
+    if (it == j.end()) where.fail(std::string("missing \"") + key + "\" (its layer)");
+    return layerFromJson(*it, where.key(key));
+  };
+  c.context = layer("context");
+  c.focus = layer("focus");
+  if (auto it = j.find("measure"); it != j.end())
+    c.measure = enumFromJson(*it, kMeasures, where.key("measure"));
+  if (auto it = j.find("contextShader"); it != j.end())
+    c.contextShader = enumFromJson(*it, kShaders, where.key("contextShader"));
+  if (auto it = j.find("focusShader"); it != j.end())
+    c.focusShader = enumFromJson(*it, kShaders, where.key("focusShader"));
+  session::clearViewFields().read(j, c, where);
+  if (!(c.size >= 0.f)) where.key("size").fail("must be >= 0 (world units; 0: automatic)");
+  if (!(c.weight >= 0.f)) where.key("weight").fail("must be >= 0");
+  if (!(c.distanceScale >= 0.f))
+    where.key("distanceScale").fail("must be >= 0 (world units; 0: the size)");
+  if (!(c.ambient >= 0.f && c.ambient <= 1.f)) where.key("ambient").fail("must lie in [0, 1]");
+  for (const auto& [key, colour] :
+       {std::pair<const char*, glm::vec3>{"contextColor", c.contextColor},
+        {"focusColor", c.focusColor},
+        {"background", c.background}})
+    if (!(colour.r >= 0.f && colour.g >= 0.f && colour.b >= 0.f))
+      where.key(key).fail("colour components must be >= 0 (linear RGB)");
+  // Whatever else the library checks (the same rules; a net for rules added there later).
+  try {
+    checkClearViewSettings(c);
+  } catch (const Error& e) {
+    std::string problem = e.what();
+    const std::string prefix = "ClearView: ";  // the library's own prefix
+    if (problem.rfind(prefix, 0) == 0) problem.erase(0, prefix.size());
+    where.fail(problem);
+  }
+  return c;
+}
+
 // Everything a version-current document holds, read into `s`.
 void readCurrent(const json& doc, Session& s, const Where& top) {
   // Data source.
@@ -142,8 +253,14 @@ void readCurrent(const json& doc, Session& s, const Where& top) {
       auto file = it->find("file");
       if (file == it->end()) w.fail("missing \"file\"");
       s.importance.volume = referenceFromJson(*file, w.key("file"));
+    } else if (kind == "hotspot") {
+      s.importance.kind = SessionImportance::Kind::Hotspot;
+      session::readRequired(*it, "centre", s.importance.hotspotCentre, w);
+      session::readRequired(*it, "radius", s.importance.hotspotRadius, w);
+      if (!(s.importance.hotspotRadius > 0.f))
+        w.key("radius").fail("must be positive (world units)");
     } else if (kind != "none") {
-      w.key("kind").fail("expected \"scene\", \"curve\" or \"volume\"");
+      w.key("kind").fail("expected \"scene\", \"curve\", \"volume\" or \"hotspot\"");
     }
   }
   if (auto it = doc.find("contextSurfaces"); it != doc.end()) {
@@ -201,6 +318,8 @@ void readCurrent(const json& doc, Session& s, const Where& top) {
   session::readOptional(doc, "frozen", s.frozen, top);
   if (auto it = doc.find("worldMask"); it != doc.end())
     s.worldMask = maskFromJson(*it, top.key("worldMask"));
+  if (auto it = doc.find("clearView"); it != doc.end())
+    s.clearView = clearViewFromJson(*it, top.key("clearView"));
 }
 
 std::string oneLine(std::string text) {
@@ -228,6 +347,9 @@ std::string sessionToJson(const Session& s, const std::string& sessionPath) {
       imp["points"] = std::move(points);
     } else if (s.importance.kind == SessionImportance::Kind::Volume) {
       imp["file"] = referenceToJson(rebaseDataReference(s.importance.volume, sessionPath));
+    } else if (s.importance.kind == SessionImportance::Kind::Hotspot) {
+      imp["centre"] = session::toJson(s.importance.hotspotCentre);
+      imp["radius"] = session::toJson(s.importance.hotspotRadius);
     }
     doc["importance"] = std::move(imp);
   }
@@ -260,6 +382,7 @@ std::string sessionToJson(const Session& s, const std::string& sessionPath) {
   }
   if (s.frozen) doc["frozen"] = true;
   if (s.worldMask) doc["worldMask"] = maskToJson(*s.worldMask);
+  if (s.clearView) doc["clearView"] = clearViewToJson(*s.clearView);
   return doc.dump(2) + "\n";
 }
 
@@ -304,6 +427,8 @@ const char* toString(SessionImportance::Kind kind) {
       return "curve";
     case SessionImportance::Kind::Volume:
       return "volume";
+    case SessionImportance::Kind::Hotspot:
+      return "hotspot";
     case SessionImportance::Kind::None:
       break;
   }

@@ -43,10 +43,19 @@ void renameSections(nlohmann::json& doc, const Where& where) {
   renameKey(doc, "surfaces", "contextSurfaces", where);
 }
 
+// v3 -> v4: two additions, nothing renamed: the ClearView hotspot's settings ("clearView") and
+// the importance kind "hotspot". A version-3 reader ignored keys it did not know, so a
+// "clearView" in a version-3 file was never visopt's and meant nothing: it is dropped rather than
+// read as settings. ("hotspot" was refused as an importance kind by version 3, so no version-3
+// file holds it.)
+void addClearView(nlohmann::json& doc, const Where&) {
+  doc.erase("clearView");
+}
+
 }  // namespace
 
 const std::vector<Converter>& converters() {
-  static const std::vector<Converter> list = {&cameraOrbitToFrame, &renameSections};
+  static const std::vector<Converter> list = {&cameraOrbitToFrame, &renameSections, &addClearView};
   return list;
 }
 

@@ -114,4 +114,20 @@ const FieldTable<PointLight>& lightFields() {
   return table;
 }
 
+const FieldTable<ClearViewSettings>& clearViewFields() {
+  using S = ClearViewSettings;
+  static const auto table = FieldTable<S>()
+                                .add("volumeLayer", &S::volumeLayer)
+                                .add("size", &S::size)
+                                .add("weight", &S::weight)
+                                .add("distanceScale", &S::distanceScale)
+                                .add("border", &S::border)
+                                .add("ambient", &S::ambient)
+                                .add("headlight", &S::headlight)
+                                .add("contextColor", &S::contextColor)
+                                .add("focusColor", &S::focusColor)
+                                .add("background", &S::background);
+  return table;
+}
+
 }  // namespace visopt::session

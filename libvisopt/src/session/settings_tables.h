@@ -3,6 +3,7 @@
 #pragma once
 
 #include "session/json_fields.h"
+#include "visopt/clearview.h"
 #include "visopt/engine.h"
 #include "visopt/level_set.h"
 #include "visopt/optimization.h"
@@ -17,5 +18,8 @@ const FieldTable<RenderSettings>& renderFields();
 const FieldTable<ContextSurfaceSpec>& surfaceFields();  // all but "source"
 const FieldTable<Camera>& cameraFields();
 const FieldTable<PointLight>& lightFields();
+// The plain members of ClearViewSettings a session stores: not the layers, measure and shaders
+// (session_json.cpp writes those by name), nor width, height and focusPixel (the view's).
+const FieldTable<ClearViewSettings>& clearViewFields();
 
 }  // namespace visopt::session

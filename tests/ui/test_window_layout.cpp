@@ -49,8 +49,8 @@ QDockWidget* panel(MainWindow& w, const QString& title) {
 }
 
 const QStringList kPanels = {QStringLiteral("Transfer function"), QStringLiteral("Importance"),
-                             QStringLiteral("Surfaces"), QStringLiteral("Optimisation"),
-                             QStringLiteral("Deviation")};
+                             QStringLiteral("Surfaces"),          QStringLiteral("Optimisation"),
+                             QStringLiteral("Deviation"),         QStringLiteral("Hotspot")};
 
 QAction* menuAction(MainWindow& w, const QString& text) {
   for (QAction* menu : w.menuBar()->actions())

@@ -151,7 +151,7 @@ void EngineController::setRenderSettings(const RenderSettings& settings) {
   {
     std::lock_guard lock(mutex_);
     render_ = settings;
-    frameOwed_ = true;
+    oweFrameLocked();
   }
   wake_.notify_all();
 }
@@ -167,7 +167,7 @@ void EngineController::setViewportSize(int width, int height) {
     if (width == viewportWidth_ && height == viewportHeight_) return;
     viewportWidth_ = std::max(16, width);
     viewportHeight_ = std::max(16, height);
-    frameOwed_ = true;
+    oweFrameLocked();
   }
   wake_.notify_all();
 }
@@ -175,7 +175,7 @@ void EngineController::setViewportSize(int width, int height) {
 void EngineController::requestFrame() {
   {
     std::lock_guard lock(mutex_);
-    frameOwed_ = true;
+    oweFrameLocked();
   }
   wake_.notify_all();
 }
@@ -203,7 +203,7 @@ bool EngineController::waitIdle(int timeoutMs) {
 
 bool EngineController::hasWorkLocked() const {
   const bool optimizing =
-      running_ && !converged_ && !interacting_ && snapshot_ && snapshot_->volume;
+      running_ && !converged_ && !interacting_ && !clearView_ && snapshot_ && snapshot_->volume;
   return !tasks_.empty() || cameraDirty_ || frameOwed_ || (previewShown_ && !interacting_) ||
          optimizing;
 }
@@ -236,15 +236,19 @@ void EngineController::runTask(Engine& engine, Task& task) {
   if (task.isLong) deliver([this, ok] { emit longWorkFinished(ok); });
   follow_.reset();
   std::lock_guard lock(mutex_);
-  frameOwed_ = true;
+  oweFrameLocked();
   converged_ = false;
+  clearViewRefused_.reset();  // the scene may have changed: ClearView tries again
 }
 
 void EngineController::renderFrame(Engine& engine, bool preview) {
+  if (renderClearViewFrame(engine, preview)) return;
   RenderSettings settings;
   FrameInfo info;
+  uint64_t owedAt;
   {
     std::lock_guard lock(mutex_);
+    owedAt = owedSerial_;
     settings = render_;
     settings.width = viewportWidth_;
     settings.height = viewportHeight_;
@@ -274,7 +278,7 @@ void EngineController::renderFrame(Engine& engine, bool preview) {
   {
     std::lock_guard lock(mutex_);
     previewShown_ = preview;
-    if (!preview) frameOwed_ = false;
+    if (!preview && owedSerial_ == owedAt) frameOwed_ = false;
   }
   sinceFrame_.restart();
   itersSinceFrame_ = 0;
@@ -284,7 +288,7 @@ void EngineController::renderFrame(Engine& engine, bool preview) {
 void EngineController::optimizeStep(Engine& engine) {
   const auto interrupt = [this] {
     std::lock_guard lock(mutex_);
-    return quit_ || !tasks_.empty() || cameraDirty_ || !running_;
+    return quit_ || !tasks_.empty() || cameraDirty_ || !running_ || clearView_.has_value();
   };
   const auto report = [this, &engine](const IterationStats& st) {
     const qulonglong bytes = engine.ledger().totalBytes();
@@ -315,7 +319,7 @@ void EngineController::optimizeStep(Engine& engine) {
     // The coarse-to-fine schedule ran to its end (each level to its tolerance or cap).
     if (!interrupted) settle();
     std::lock_guard lock(mutex_);
-    frameOwed_ = true;
+    oweFrameLocked();
     return;
   }
   if (engine.frozen()) {
@@ -331,7 +335,7 @@ void EngineController::optimizeStep(Engine& engine) {
   // level's iteration budget (follow_convergence.h).
   if (follow_.add(stats.back(), engine.extinctionSettings())) settle();
   std::lock_guard lock(mutex_);
-  frameOwed_ = true;
+  oweFrameLocked();
 }
 
 void EngineController::workerLoop() {
@@ -359,7 +363,7 @@ void EngineController::workerLoop() {
       continue;
     }
 
-    bool cameraChanged = false, interacting = false;
+    bool cameraChanged = false, interacting = false, clearViewOn = false;
     Camera cam;
     int w, h;
     {
@@ -369,8 +373,10 @@ void EngineController::workerLoop() {
         renderedSerial_ = cameraSerial_;
         cameraDirty_ = false;
         cameraChanged = true;
+        clearViewRefused_.reset();
       }
       interacting = interacting_;
+      clearViewOn = clearView_.has_value();
       w = viewportWidth_;
       h = viewportHeight_;
     }
@@ -398,7 +404,9 @@ void EngineController::workerLoop() {
       continue;
     }
     // While the user drags, only previews: an iteration in flight is all the camera waits for.
-    const bool optimizing = running_ && !converged_ && !interacting && engine.hasImportance();
+    // ClearView's frames do not show the optimisation: it waits while they are on.
+    const bool optimizing =
+        running_ && !converged_ && !interacting && !clearViewOn && engine.hasImportance();
     if (optimizing) {
       try {
         optimizeStep(engine);

@@ -4,6 +4,8 @@
 // iteration at the current camera (Himmler & Günther 2026, §III-F "Navigation": the optimisation
 // follows the camera, warm-started from the current mu) with a render; while the user drags the
 // camera it renders low-resolution previews first and the full image once the camera rests.
+// While ClearView is on (the Hotspot tool) the frames are ClearView's instead, and a hotspot that
+// moves only composites (engine_controller_clearview.cpp).
 #pragma once
 
 #include <atomic>
@@ -20,6 +22,7 @@
 #include <QObject>
 #include <QString>
 
+#include <visopt/clearview.h>
 #include <visopt/engine.h>
 
 #include "follow_convergence.h"
@@ -33,6 +36,10 @@ struct FrameInfo {
   double renderMs = 0.0;
   uint64_t cameraSerial = 0;  // the setCamera call this frame shows (latency measurement)
   Camera camera;
+  // A ClearView frame (EngineController::setClearView) and what its render did: whether it
+  // extracted the layers or composited only, the extractions so far, the times.
+  bool clearView = false;
+  ClearViewStats clearViewStats;
 };
 
 class EngineController : public QObject {
@@ -78,6 +85,21 @@ class EngineController : public QObject {
   bool optimizationRunning() const { return running_; }
   void restartOptimization();  // from mu_bar, coarse to fine
 
+  // ClearView (Krüger et al. 2006; the Hotspot tool): while set, every frame is
+  // Engine::renderClearView with `settings` instead of the normal render, and the optimisation
+  // waits (each iteration moves the context surfaces, so every frame would extract the layers
+  // again). The frame's size replaces the settings' width and height (a camera drag renders
+  // 1/previewFactor of it first, as the normal preview does) and setClearViewFocus's position
+  // their focusPixel. A render the library refuses (Error: a layer the scene lacks, a value out of
+  // range) is reported through clearViewFailed, and the normal render is shown instead.
+  // nullopt: normal frames (and the optimisation) again.
+  void setClearView(std::optional<ClearViewSettings> settings);
+  std::optional<ClearViewSettings> clearView() const;
+  // The hotspot's position as a fraction of the image (x right, y down, in [0, 1]; negative: the
+  // image centre), so that it maps onto whatever size the frame has. Only the newest position is
+  // rendered: one that the worker has not picked up yet is simply replaced.
+  void setClearViewFocus(glm::vec2 fraction);
+
   // Waits until the worker has nothing left to do right now: no command queued, no frame owed
   // (tests and --screenshot). Returns false on timeout.
   bool waitIdle(int timeoutMs);
@@ -93,6 +115,9 @@ class EngineController : public QObject {
   void progressChanged(const QString& stage, double fraction);
   void longWorkFinished(bool ok);
   void convergedChanged(bool converged);
+  // The library's message for a ClearView frame it refused (no dialog: the Hotspot panel and
+  // the status bar show it until a ClearView frame succeeds).
+  void clearViewFailed(const QString& message);
 
  private:
   struct Task {
@@ -105,6 +130,9 @@ class EngineController : public QObject {
   void runTask(Engine& engine, Task& task);
   void optimizeStep(Engine& engine);
   void renderFrame(Engine& engine, bool preview);
+  // ClearView's frame when it is on: true when the frame is done (rendered, or refused before for
+  // the same settings and nothing changed since); false: render the normal frame.
+  bool renderClearViewFrame(Engine& engine, bool preview);
   void deliver(std::function<void()> onUiThread);  // queued to the UI thread
 
   const Precision precision_;
@@ -121,7 +149,14 @@ class EngineController : public QObject {
   uint64_t cameraSerial_ = 0, renderedSerial_ = 0;
   bool cameraDirty_ = false;
   bool interacting_ = false;
-  bool frameOwed_ = false;     // something changed since the last full frame
+  bool frameOwed_ = false;  // something changed since the last full frame
+  // Counts the changes that owe a frame: a full frame settles what was owed only when none came
+  // while it rendered (one that did, an edit or a ClearView setting, gets a frame of its own).
+  uint64_t owedSerial_ = 0;
+  void oweFrameLocked() {
+    frameOwed_ = true;
+    ++owedSerial_;
+  }
   bool previewShown_ = false;  // the last frame was a preview
   RenderSettings render_;
   int viewportWidth_ = 512, viewportHeight_ = 512;
@@ -136,6 +171,14 @@ class EngineController : public QObject {
   QElapsedTimer sinceFrame_;
 
   std::shared_ptr<const SceneSnapshot> snapshot_;
+
+  // ClearView: the UI's settings and hotspot (under mutex_); the settings of the last refused
+  // render (under mutex_; forgotten when the settings, the camera or the scene change); the
+  // worker's image, reused from frame to frame.
+  std::optional<ClearViewSettings> clearView_;
+  glm::vec2 clearViewFocus_{-1.f, -1.f};
+  std::optional<ClearViewSettings> clearViewRefused_;
+  Image clearViewImage_;
 };
 
 }  // namespace visopt::ws

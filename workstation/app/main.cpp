@@ -5,6 +5,8 @@
 // from a camera drag to the preview on screen while the optimisation runs.
 #include <cstdio>
 
+#include <QAction>
+#include <QActionGroup>
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QDockWidget>
@@ -154,8 +156,12 @@ int main(int argc, char** argv) {
   QCommandLineOption tab(QStringLiteral("show-panel"),
                          QStringLiteral("Bring the dock panel with this title to the front."),
                          QStringLiteral("TITLE"));
+  QCommandLineOption tool(QStringLiteral("tool"),
+                          QStringLiteral("Start with the tool of this name (its tool bar text: "
+                                         "Navigate, Paint mask, Lens, Window mask, Hotspot)."),
+                          QStringLiteral("NAME"));
   parser.addOptions({scene, volume, session, resolution, screenshot, windowShot, size, noOptimize,
-                     latency, probeFrames, stateDir, timeout, saveTo, deviation, tab});
+                     latency, probeFrames, stateDir, timeout, saveTo, deviation, tab, tool});
   parser.addPositionalArgument(
       QStringLiteral("files"),
       QStringLiteral("A volume file or DICOM folder, or a session (.visopt-session, .json), to "
@@ -215,6 +221,20 @@ int main(int argc, char** argv) {
         dock->show();
         dock->raise();
       }
+
+  if (parser.isSet(tool)) {
+    QAction* chosen = nullptr;
+    for (QAction* a : window.findChildren<QAction*>())
+      if (a->isCheckable() && a->actionGroup() &&
+          a->text().remove(QLatin1Char('&')).compare(parser.value(tool), Qt::CaseInsensitive) == 0)
+        chosen = a;
+    if (!chosen) {
+      std::fprintf(stderr, "visopt-workstation: --tool: no tool named '%s'\n",
+                   parser.value(tool).toUtf8().constData());
+      return 2;
+    }
+    chosen->trigger();
+  }
 
   if (!scripted) return app.exec();
 

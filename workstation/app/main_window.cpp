@@ -29,11 +29,14 @@
 #include <visopt/scenes.h>
 
 #include "camera_navigation.h"
+#include "hotspot_mode.h"
 #include "panels/comparison_view.h"
 #include "panels/context_surfaces_panel.h"
 #include "panels/deviation_panel.h"
+#include "panels/hotspot_panel.h"
 #include "panels/optimization_panel.h"
 #include "panels/status_summary.h"
+#include "tools/hotspot_tool.h"
 #include "tools/lens_tool.h"
 #include "tools/mask_paint_tool.h"
 #include "tools/window_mask_tool.h"
@@ -48,7 +51,7 @@ namespace {
 
 constexpr int kAutosaveIntervalMs = 3 * 60 * 1000;
 // Of the remembered panel layout: raise it when the panels change, so an old layout is ignored.
-constexpr int kLayoutVersion = 2;
+constexpr int kLayoutVersion = 3;
 const char* kSessionFilter = "visopt sessions (*.visopt-session *.json);;All files (*)";
 
 QString fromStd(const std::string& s) {
@@ -67,6 +70,7 @@ MainWindow::MainWindow(Precision precision, const QString& stateDir, QWidget* pa
   maskTool_ = new MaskPaintTool(this);
   lensTool_ = new LensTool(this);
   windowTool_ = new WindowMaskTool(this);
+  hotspotTool_ = new HotspotTool(this);
 
   buildActions();
   buildDocks();
@@ -130,6 +134,10 @@ void MainWindow::buildActions() {
       tr("Window mask"),
       tr("Paint a screen-space window: only importance seen through it counts (Ctrl+drag removes)"),
       QKeySequence(Qt::Key_W));
+  actHotspot_ = tool(tr("Hotspot"),
+                     tr("ClearView: the view opens the context around the cursor onto the focus "
+                        "behind it (Hotspot panel); wheel changes its size, drag orbits"),
+                     QKeySequence(Qt::Key_H));
   actNavigate_->setChecked(true);
   connect(toolGroup_, &QActionGroup::triggered, this, &MainWindow::chooseTool);
 
@@ -193,6 +201,8 @@ void MainWindow::buildDocks() {
   surfacesPanel_ = new ContextSurfacesPanel(this);
   optimizationPanel_ = new OptimizationPanel(this);
   deviationPanel_ = new DeviationPanel(this);
+  hotspotPanel_ = new HotspotPanel(this);
+  hotspot_ = new HotspotMode(hotspotTool_, hotspotPanel_, this);
   comparisonView_ = new ComparisonView(this);
   // Volumes are mostly background: a linear histogram shows one bar and nothing else.
   tfEditor_->logScaleCheckBox()->setChecked(true);
@@ -208,9 +218,10 @@ void MainWindow::buildDocks() {
   auto* dSurf = dock(tr("Surfaces"), surfacesPanel_, Qt::RightDockWidgetArea);
   auto* dOpt = dock(tr("Optimisation"), optimizationPanel_, Qt::RightDockWidgetArea);
   auto* dDev = dock(tr("Deviation"), deviationPanel_, Qt::RightDockWidgetArea);
+  auto* dHot = dock(tr("Hotspot"), hotspotPanel_, Qt::RightDockWidgetArea);
   comparisonDock_ = dock(tr("Comparison"), comparisonView_, Qt::BottomDockWidgetArea);
   comparisonDock_->hide();
-  panels_ = {dTf, dImp, dSurf, dOpt, dDev};
+  panels_ = {dTf, dImp, dSurf, dOpt, dDev, dHot};
   arrangePanels();
 
   // Editors -> engine.
@@ -231,6 +242,7 @@ void MainWindow::buildDocks() {
             controller_->post(tr("Importance"),
                               [curve](Engine& e) { e.setImportanceCurve(curve); });
             importanceEditor_->setImportanceVolumeName({});
+            hotspot_->setSceneHasImportance(true);
             setModified();
           });
   connect(importanceEditor_, &ImportanceEditor::importanceVolumeRequested, this,
@@ -241,6 +253,7 @@ void MainWindow::buildDocks() {
                                   });
             importanceEditor_->setImportanceVolumeName(
                 tr("the volume %1").arg(QFileInfo(path).fileName()));
+            hotspot_->setSceneHasImportance(true);
             setModified();
           });
   connect(importanceEditor_, &ImportanceEditor::overlayToggled, this, [this](bool on) {
@@ -328,6 +341,10 @@ void MainWindow::buildDocks() {
           });
   connect(windowTool_, &WindowMaskTool::windowMaskCleared, this,
           [this] { controller_->post(tr("Window mask"), [](Engine& e) { e.clearScreenMask(); }); });
+  connect(hotspot_, &HotspotMode::settingsEdited, this, [this] { setModified(); });
+  connect(hotspot_, &HotspotMode::problemChanged, this, [this](const QString& message) {
+    if (!message.isEmpty()) statusBar()->showMessage(message, 15000);
+  });
 }
 
 void MainWindow::buildMenus() {
@@ -492,6 +509,7 @@ void MainWindow::connectController() {
   connect(c, &EngineController::longWorkStarted, this, &MainWindow::onLongWorkStarted);
   connect(c, &EngineController::progressChanged, this, &MainWindow::onProgress);
   connect(c, &EngineController::longWorkFinished, this, &MainWindow::onLongWorkFinished);
+  hotspot_->setController(c);
 }
 
 // ---- state and status -----------------------------------------------------------------------
@@ -518,9 +536,13 @@ void MainWindow::updateTitle() {
 }
 
 void MainWindow::updateStatus() {
-  statusLabel_->setText(formatStatus(lastStats_ ? &*lastStats_ : nullptr,
-                                     viewport_->framesPerSecond(), size_t(ledgerBytes_), frozen_,
-                                     controller_->optimizationRunning()));
+  // The optimisation waits while ClearView shows (EngineController::setClearView): "paused".
+  QString text = formatStatus(lastStats_ ? &*lastStats_ : nullptr, viewport_->framesPerSecond(),
+                              size_t(ledgerBytes_), frozen_,
+                              controller_->optimizationRunning() && !hotspot_->active());
+  if (const QString hotspot = hotspot_->statusText(); !hotspot.isEmpty())
+    text += QStringLiteral(" · ") + hotspot;
+  statusLabel_->setText(text);
 }
 
 void MainWindow::updateRecentMenu() {
@@ -668,6 +690,7 @@ void MainWindow::applySessionToPanels(const Session& s) {
     actMaskOverlay_->setChecked(render_.worldMaskOverlay);
   }
   importanceEditor_->setOverlayChecked(render_.importanceOverlay > 0.f);
+  hotspot_->applySession(s.clearView, s.importance.kind != SessionImportance::Kind::None);
   controller_->setRenderSettings(render_);
   if (s.camera) {
     viewport_->setHomeCamera(*s.camera);
@@ -696,10 +719,12 @@ void MainWindow::onSceneChanged() {
     histogram_ = std::make_shared<const Histogram>(computeHistogram(*snap->volume));
     tfEditor_->setHistogram(histogram_);
     importanceEditor_->setHistogram(histogram_);
+    hotspotPanel_->setHistogram(histogram_);
     histogramVolume_ = snap->volume->normalized.raw();
   }
   surfacesPanel_->setValueRange(snap->volume->valueMin, snap->volume->valueMax);
   surfacesPanel_->setSurfaces(snap->surfaces);
+  hotspot_->sceneChanged(*snap);
   deviationPanel_->setVoxelSize(snap->volume->grid().minSpacing());
   if (snap->volume.get() != brushVolume_) {
     // A new volume: a brush of 4 % of its size, the value range spanning its data.
@@ -758,6 +783,7 @@ Session MainWindow::currentSession(const QString& sessionPath) {
     session = captureSession(e, render, path);
     session.camera = camera;  // the UI's camera, which the worker may not have picked up yet
   });
+  session.clearView = hotspot_->sessionSettings();
   return session;
 }
 
@@ -996,6 +1022,8 @@ void MainWindow::chooseTool(QAction* action) {
     viewport_->setTool(lensTool_);
   else if (action == actWindow_)
     viewport_->setTool(windowTool_);
+  else if (action == actHotspot_)
+    viewport_->setTool(hotspotTool_);
   else
     viewport_->setTool(nullptr);
   if (action == actLens_) lensTool_->setLensOn(true);
@@ -1083,12 +1111,14 @@ void MainWindow::rebuildEngine(Precision precision) {
   const QString keepPath = sessionPath_;
   controller_ = std::make_unique<EngineController>(precision);
   auto* old = viewport_;
+  ViewportTool* activeTool = old->tool();
   viewport_ = new ViewportWidget(controller_.get(), this);
   setCentralWidget(viewport_);
   old->deleteLater();
   connectController();
   controller_->setRenderSettings(render_);
   controller_->setOptimizationRunning(actRun_->isChecked());
+  viewport_->setTool(activeTool);  // the active tool carries over
   if (haveScene) {
     openSession(tmp);
     QFile::remove(tmp);

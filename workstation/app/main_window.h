@@ -39,6 +39,9 @@ class ComparisonView;
 class MaskPaintTool;
 class LensTool;
 class WindowMaskTool;
+class HotspotTool;
+class HotspotPanel;
+class HotspotMode;
 struct Histogram;
 
 class MainWindow : public QMainWindow {
@@ -94,6 +97,9 @@ class MainWindow : public QMainWindow {
   MaskPaintTool* maskTool() const { return maskTool_; }
   LensTool* lensTool() const { return lensTool_; }
   WindowMaskTool* windowMaskTool() const { return windowTool_; }
+  HotspotTool* hotspotTool() const { return hotspotTool_; }
+  HotspotPanel* hotspotPanel() const { return hotspotPanel_; }
+  HotspotMode* hotspotMode() const { return hotspot_; }
   const SessionFiles& sessionFiles() const { return files_; }
   const QString& sessionPath() const { return sessionPath_; }
   bool modified() const { return modified_; }
@@ -187,6 +193,9 @@ class MainWindow : public QMainWindow {
   MaskPaintTool* maskTool_ = nullptr;
   LensTool* lensTool_ = nullptr;
   WindowMaskTool* windowTool_ = nullptr;
+  HotspotTool* hotspotTool_ = nullptr;
+  HotspotPanel* hotspotPanel_ = nullptr;
+  HotspotMode* hotspot_ = nullptr;  // hotspot_mode.h: the tool, the panel and ClearView frames
   QLabel* statusLabel_ = nullptr;
   QPointer<QProgressDialog> progress_;
   QTimer autosaveTimer_;
@@ -195,6 +204,7 @@ class MainWindow : public QMainWindow {
   QMenu* recentMenu_ = nullptr;
   QActionGroup* toolGroup_ = nullptr;
   QAction *actNavigate_ = nullptr, *actPaint_ = nullptr, *actLens_ = nullptr, *actWindow_ = nullptr;
+  QAction* actHotspot_ = nullptr;
   QAction *actUndo_ = nullptr, *actRedo_ = nullptr;
   QAction *actRun_ = nullptr, *actFreeze_ = nullptr, *actLookElsewhere_ = nullptr;
   QAction* actMaskOverlay_ = nullptr;

@@ -9,6 +9,7 @@
 
 #include <QStatusBar>
 
+#include "hotspot_mode.h"
 #include "main_window.h"
 #include "widgets/importance_editor.h"
 #include "widgets/transfer_function_editor.h"
@@ -33,6 +34,7 @@ void MainWindow::applyImportanceCurve(const std::vector<glm::dvec2>& curve,
                                       const std::string& origin) {
   importanceEditor_->setCurve(curve);
   importanceEditor_->setImportanceVolumeName({});
+  hotspot_->setSceneHasImportance(true);  // the hotspot's default focus becomes the importance
   controller_->post(tr("Importance"),
                     [curve, origin](Engine& e) { e.setImportanceCurve(curve, origin); });
   setModified();

@@ -39,6 +39,8 @@ class ViewportTool : public QObject {
   virtual bool mouseRelease(QMouseEvent*, const ViewContext&) { return false; }
   virtual bool wheel(QWheelEvent*, const ViewContext&) { return false; }
   virtual bool keyPress(QKeyEvent*, const ViewContext&) { return false; }
+  // Called when the tool becomes the active one (the hotspot turns ClearView on).
+  virtual void activate() {}
   // Called when the tool stops being the active one (a stroke in progress is cancelled).
   virtual void deactivate() {}
   // Draws the tool's overlay (brush outline, lens circle) over the image.

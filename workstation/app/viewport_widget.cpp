@@ -34,7 +34,10 @@ void ViewportWidget::setTool(ViewportTool* tool) {
     disconnect(tool_, nullptr, this, nullptr);
   }
   tool_ = tool;
-  if (tool_) connect(tool_, &ViewportTool::overlayChanged, this, qOverload<>(&QWidget::update));
+  if (tool_) {
+    connect(tool_, &ViewportTool::overlayChanged, this, qOverload<>(&QWidget::update));
+    tool_->activate();
+  }
   update();
 }
 

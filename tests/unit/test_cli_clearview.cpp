@@ -248,3 +248,29 @@ TEST(CliClearView, OptimizeTakesTheHotspotAsItsImportance) {
     EXPECT_NE(lines[0].find("--importance"), std::string::npos) << lines[0];
   }
 }
+
+// A session's hotspot settings (saved by the workstation's Hotspot panel) are the defaults of
+// `render --session S --clearview SPEC`; SPEC's keys override them.
+TEST(CliClearView, ASessionsHotspotSettingsAreTheDefaults) {
+  const std::string session = tmp("hotspot.visopt-session");
+  {
+    std::ofstream f(session);
+    f << R"({"format": "visopt-session", "version": 4,
+             "data": {"builtin": "shepp-logan", "resolution": 32},
+             "clearView": {"context": {"kind": "iso", "isovalue": 0.37},
+                           "focus": {"kind": "importance", "isovalue": 0.5},
+                           "measure": "view-distance", "weight": 0.3}})";
+  }
+  Result r = run("render --session " + session + " --size 48x40 --clearview '' --out " +
+                 tmp("session-cv.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["clearview"]["measure"], "view-distance");
+  EXPECT_EQ(j["clearview"]["context"], "iso:0.37");
+  r = run("render --session " + session + " --size 48x40 --clearview measure=distance --out " +
+          tmp("session-cv.png") + " --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["clearview"]["measure"], "distance");
+  EXPECT_EQ(j["clearview"]["context"], "iso:0.37");
+}

@@ -149,8 +149,8 @@ std::string describeClearViewLayer(const ClearViewLayer& layer) {
 }
 
 ClearViewSettings parseClearViewSpec(const Engine& engine, const std::string& spec,
-                                     glm::ivec2 imageSize) {
-  ClearViewSettings s;
+                                     glm::ivec2 imageSize, const ClearViewSettings* base) {
+  ClearViewSettings s = base ? *base : ClearViewSettings{};
   s.width = imageSize.x;
   s.height = imageSize.y;
   std::set<std::string, std::less<>> seen;
@@ -228,14 +228,14 @@ ClearViewSettings parseClearViewSpec(const Engine& engine, const std::string& sp
     }
   }
 
-  // The layers' defaults follow the scene.
-  if (!seen.count("context")) {
+  // The layers' defaults follow the scene (a session's settings carry their own layers).
+  if (!seen.count("context") && !base) {
     if (engine.contextSurfaces().empty())
       throw Error(ErrorKind::Usage,
                   "--clearview: give context=iso:VALUE (this scene has no context surface)");
     s.context = ClearViewLayer{ClearViewLayerKind::ContextSurface, 0.0, 0};
   }
-  if (!seen.count("focus")) {
+  if (!seen.count("focus") && !base) {
     if (!engine.hasImportance())
       throw Error(ErrorKind::Usage,
                   "--clearview: give focus=iso:VALUE (this scene has no importance)");

@@ -22,9 +22,11 @@ namespace visopt::cli {
 //   shader=, focus-shader=diffuse|cool-warm|skin|bone
 //   at=PX:PY  size=MM  weight=W  distance-scale=MM  border=0|1  ambient=A  light=camera|scene
 // `imageSize` (the render's --size) becomes the settings' width and height and bounds at=.
-// Throws Error(Usage) with one line naming --clearview and the offending element.
+// `base` (a session's saved settings, or null) replaces the defaults, layers included; SPEC's
+// keys override it. Throws Error(Usage) with one line naming --clearview and the offending
+// element.
 ClearViewSettings parseClearViewSpec(const Engine& engine, const std::string& spec,
-                                     glm::ivec2 imageSize);
+                                     glm::ivec2 imageSize, const ClearViewSettings* base = nullptr);
 
 // A usage error of the library's ClearView checks (checkClearViewSettings, or the Engine's checks
 // of the layers against the scene) as this option's: "--clearview: PROBLEM".

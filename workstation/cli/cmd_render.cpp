@@ -121,8 +121,11 @@ Runner addRenderCommand(CLI::App& app) {
     if (!session || o->noJitter) settings.jitter = !o->noJitter;
     if (clearview) {
       // After the scene, the camera and the size: the layers' defaults follow the scene.
+      // A session's hotspot settings (the workstation's Hotspot panel) are the defaults here.
+      const ClearViewSettings* saved =
+          session && session->clearView ? &*session->clearView : nullptr;
       const ClearViewSettings cv =
-          parseClearViewSpec(engine, o->clearview, {settings.width, settings.height});
+          parseClearViewSpec(engine, o->clearview, {settings.width, settings.height}, saved);
       ClearViewStats cvStats;
       Image image;
       try {

@@ -201,6 +201,7 @@ class TestHotspotTool : public QObject {
   void panelSettingsChangeTheFrame();
   void refusedCombinationsAreMessagesNotCrashes();
   void sessionKeepsTheHotspotSettings();
+  void optimiseAroundTheHotspotMakesItTheImportance();
 };
 
 void TestHotspotTool::initTestCase() {
@@ -616,6 +617,34 @@ void TestHotspotTool::sessionKeepsTheHotspotSettings() {
   QVERIFY(!w2->hotspotMode()->sessionSettings());
   QCOMPARE(w2->hotspotMode()->settings().measure, ClearViewMeasure::Curvature);
   QCOMPARE(w2->hotspotTool()->size(), 0.f);
+}
+
+// "Optimise around the hotspot": the last frame's focus point and radius become the importance
+// (a smooth ball), the view returns to the normal render and the optimisation runs for it.
+void TestHotspotTool::optimiseAroundTheHotspotMakesItTheImportance() {
+  auto w = openScene(QStringLiteral("optimise-around"));
+  QVERIFY(settle(*w));
+  ViewportWidget* view = w->viewport();
+  auto* button = w->hotspotPanel()->findChild<QPushButton*>(QStringLiteral("optimiseAround"));
+  QVERIFY(button);
+  QVERIFY(!button->isEnabled());  // no ClearView frame yet
+  QVERIFY(pressH(*w));
+  QVERIFY(w->waitForSettledFrame(kSettleMs));
+  const std::optional<ClearViewStats> stats = w->hotspotMode()->lastStats();
+  QVERIFY(stats && stats->hasFocusPoint && stats->size > 0.f);
+  QVERIFY(button->isEnabled());
+  QSignalSpy iterations(w->controller(), &EngineController::iterationDone);
+  button->click();
+  QVERIFY(!w->hotspotMode()->active());
+  QTRY_VERIFY_WITH_TIMEOUT(iterations.count() > 0, kSettleMs);
+  w->setOptimizationRunning(false);
+  QVERIFY(w->waitForSettledFrame(kSettleMs));
+  Engine::ImportanceSource source;
+  w->controller()->call([&](Engine& e) { source = e.importanceSource(); });
+  QCOMPARE(source.kind, ImportanceKind::Hotspot);
+  QVERIFY(glm::length(source.hotspotCentre - stats->focusPoint) < 1e-4f);
+  QCOMPARE(source.hotspotRadius, stats->size);
+  QVERIFY(!view->frame().isNull());
 }
 
 QTEST_MAIN(TestHotspotTool)

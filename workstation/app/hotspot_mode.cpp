@@ -36,6 +36,10 @@ HotspotMode::HotspotMode(HotspotTool* tool, HotspotPanel* panel, QObject* parent
   });
   connect(panel_, &HotspotPanel::settingsEdited, this,
           [this](const ClearViewSettings& s) { setUserSettings(s); });
+  connect(panel_, &HotspotPanel::optimiseAroundRequested, this, [this] {
+    if (lastStats_ && lastStats_->hasFocusPoint && lastStats_->size > 0.f)
+      emit optimiseAroundRequested();
+  });
   connect(panel_, &HotspotPanel::resetRequested, this, [this] {
     edited_ = false;
     settings_ = sceneDefaults();

@@ -67,6 +67,9 @@ class HotspotMode : public QObject {
 
  signals:
   void settingsEdited();  // by the user (the session changed)
+  // "Optimise around the hotspot", with a last frame that has a focus point (lastStats():
+  // its focusPoint and size).
+  void optimiseAroundRequested();
   void problemChanged(const QString& message);
 
  private:

@@ -342,6 +342,23 @@ void MainWindow::buildDocks() {
   connect(windowTool_, &WindowMaskTool::windowMaskCleared, this,
           [this] { controller_->post(tr("Window mask"), [](Engine& e) { e.clearScreenMask(); }); });
   connect(hotspot_, &HotspotMode::settingsEdited, this, [this] { setModified(); });
+  // The hotspot drives the optimisation: its ball becomes the importance, the view returns to
+  // the normal render (ClearView pauses the optimisation) and the optimisation runs.
+  connect(hotspot_, &HotspotMode::optimiseAroundRequested, this, [this] {
+    const glm::vec3 centre = hotspot_->lastStats()->focusPoint;
+    const float radius = hotspot_->lastStats()->size;
+    controller_->post(tr("Importance: the hotspot"),
+                      [centre, radius](Engine& e) { e.setImportanceHotspot(centre, radius); });
+    importanceEditor_->setImportanceVolumeName(tr("the hotspot: a ball of %1 about (%2, %3, %4)")
+                                                   .arg(double(radius), 0, 'f', 1)
+                                                   .arg(double(centre.x), 0, 'f', 1)
+                                                   .arg(double(centre.y), 0, 'f', 1)
+                                                   .arg(double(centre.z), 0, 'f', 1));
+    actNavigate_->trigger();
+    controller_->restartOptimization();
+    actRun_->setChecked(true);
+    setModified();
+  });
   connect(hotspot_, &HotspotMode::problemChanged, this, [this](const QString& message) {
     if (!message.isEmpty()) statusBar()->showMessage(message, 15000);
   });

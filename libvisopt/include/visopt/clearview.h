@@ -86,6 +86,7 @@ struct ClearViewStats {
   bool hasFocusPoint = false;
   glm::vec3 focusPoint{0.f};  // C in world units, when the focus pixel sees the focus layer
   int64_t contextPixels = 0, focusPixels = 0;  // pixels where each surface layer was hit
+  float size = 0.f;  // the hotspot radius s used, world units (the automatic one when size was 0)
 };
 
 // Throws Error(Usage) naming what is wrong (image size, size, weights, colours, the layers'

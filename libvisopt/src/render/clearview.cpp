@@ -222,6 +222,7 @@ void compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& 
   if (stats) {
     stats->compositeMs = msSince(start);
     stats->hasFocusPoint = p.hasFocusPoint;
+    stats->size = size;
     stats->focusPoint = p.focusPoint;
     stats->contextPixels = layers.contextPixels;
     stats->focusPixels = layers.focusPixels;

@@ -427,6 +427,15 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
       tr("Every setting back to its default for this scene (as `visopt render --clearview` "
          "chooses them)."));
   layout->addWidget(reset_);
+  optimiseAround_ = new QPushButton(tr("Optimise around the hotspot"), this);
+  optimiseAround_->setObjectName(QStringLiteral("optimiseAround"));
+  optimiseAround_->setToolTip(
+      tr("Makes the importance a smooth ball about the last focus point, of the hotspot's "
+         "radius (1 within half of it, 0 beyond it), and runs the visibility optimisation "
+         "(Himmler & Günther 2026) for it: the context opens where you pointed. Needs a "
+         "ClearView frame whose cursor saw the focus layer."));
+  optimiseAround_->setEnabled(false);
+  layout->addWidget(optimiseAround_);
 
   problem_ = new QLabel(this);
   problem_->setObjectName(QStringLiteral("problem"));
@@ -454,6 +463,7 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
   for (QCheckBox* box : {border_, volumeLayer_})
     connect(box, &QCheckBox::toggled, this, &HotspotPanel::onEdited);
   connect(reset_, &QPushButton::clicked, this, &HotspotPanel::resetRequested);
+  connect(optimiseAround_, &QPushButton::clicked, this, &HotspotPanel::optimiseAroundRequested);
 }
 
 void HotspotPanel::setScene(const std::vector<ContextSurfaceSpec>& surfaces, double valueMin,
@@ -530,11 +540,13 @@ void HotspotPanel::setStats(const ClearViewStats& st) {
   text += tr(" · composited in %1 ms · %2 extractions")
               .arg(st.compositeMs, 0, 'f', 1)
               .arg(qlonglong(st.extractions));
+  optimiseAround_->setEnabled(st.hasFocusPoint);
   if (st.hasFocusPoint)
-    text += tr("\nFocus point (%1, %2, %3)")
+    text += tr("\nFocus point (%1, %2, %3), radius %4")
                 .arg(double(st.focusPoint.x), 0, 'f', 1)
                 .arg(double(st.focusPoint.y), 0, 'f', 1)
-                .arg(double(st.focusPoint.z), 0, 'f', 1);
+                .arg(double(st.focusPoint.z), 0, 'f', 1)
+                .arg(double(st.size), 0, 'f', 1);
   else
     text += tr("\nNo focus under the hotspot: the context stays opaque");
   stats_->setText(text);

@@ -126,7 +126,8 @@ class HotspotPanel : public QWidget {
 
  signals:
   void settingsEdited(const visopt::ClearViewSettings& settings);
-  void resetRequested();  // back to the scene's defaults
+  void resetRequested();           // back to the scene's defaults
+  void optimiseAroundRequested();  // the hotspot as the importance, then optimise
 
  private:
   void onEdited();
@@ -145,6 +146,7 @@ class HotspotPanel : public QWidget {
   QComboBox* light_ = nullptr;
   QCheckBox* volumeLayer_ = nullptr;
   QPushButton* reset_ = nullptr;
+  QPushButton* optimiseAround_ = nullptr;
   QLabel* problem_ = nullptr;
   QLabel* stats_ = nullptr;
   ClearViewSettings colours_;  // the colours, which the panel does not edit, kept as given

@@ -194,7 +194,6 @@ class TestHotspotTool : public QObject {
   Q_OBJECT
  private slots:
   void initTestCase();
-  void displayImageIsToSrgb8ByteForByte();
   void hShowsClearViewAndTheCursorOnlyComposites();
   void quickMovesRenderOnlyTheNewestOntoTheFramesPixels();
   void wheelScalesTheSizeAndDragOrbits();
@@ -207,56 +206,6 @@ class TestHotspotTool : public QObject {
 void TestHotspotTool::initTestCase() {
   QDir(testRoot()).removeRecursively();
   QVERIFY(QDir().mkpath(testRoot()));
-}
-
-// The ClearView frames' sRGB encoding (by table) is the library's (by pow), on every code's
-// threshold, out-of-range values and NaN, and costs a fraction of it.
-void TestHotspotTool::displayImageIsToSrgb8ByteForByte() {
-  Image image(800, 600);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<float> unit(-0.1f, 1.1f);
-  for (glm::vec3& p : image.pixels) p = {unit(rng), unit(rng) * unit(rng), 0.01f * unit(rng)};
-  // Around each code's boundary: the floats just below and above where the library's encoding
-  // steps (found by bisection here too, independently of the table).
-  size_t at = 0;
-  const auto put = [&](float v) { image.pixels[at++ % image.pixels.size()].g = v; };
-  for (float v : {0.f, -0.f, 1.f, 2.f, -1.f, std::nanf(""), std::numeric_limits<float>::infinity(),
-                  -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::denorm_min(),
-                  0.0031308f, std::nextafter(0.0031308f, 1.f)})
-    put(v);
-  Image probe(1, 1);
-  const auto code = [&](float v) {
-    probe.pixels[0] = glm::vec3(v);
-    return probe.toSrgb8()[0];
-  };
-  for (int k = 1; k <= 255; ++k) {
-    float lo = 0.f, hi = 1.f;
-    for (int i = 0; i < 60; ++i) {
-      const float mid = 0.5f * (lo + hi);
-      (code(mid) >= k ? hi : lo) = mid;
-    }
-    for (float v = std::nextafter(lo, 0.f), n = 0; n < 4; v = std::nextafter(v, 2.f), ++n) put(v);
-  }
-  std::vector<uint8_t> library;
-  QImage ours;
-  double libraryMs = 1e9, oursMs = 1e9;  // the best of three (the first builds the tables)
-  for (int run = 0; run < 3; ++run) {
-    QElapsedTimer clock;
-    clock.start();
-    library = image.toSrgb8();
-    libraryMs = std::min(libraryMs, double(clock.nsecsElapsed()) * 1e-6);
-    clock.restart();
-    ours = toDisplayImage(image);
-    oursMs = std::min(oursMs, double(clock.nsecsElapsed()) * 1e-6);
-  }
-  qInfo("800x600 to 8-bit sRGB: Image::toSrgb8 %.1f ms, toDisplayImage %.1f ms", libraryMs, oursMs);
-  QCOMPARE(ours.size(), QSize(800, 600));
-  QCOMPARE(ours.format(), QImage::Format_RGBA8888);
-  size_t differing = 0;
-  for (int y = 0; y < 600; ++y)
-    differing += size_t(
-        std::memcmp(ours.constScanLine(y), library.data() + size_t(y) * 800 * 4, 800 * 4) != 0);
-  QCOMPARE(differing, size_t(0));
 }
 
 void TestHotspotTool::hShowsClearViewAndTheCursorOnlyComposites() {

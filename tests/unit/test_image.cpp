@@ -7,8 +7,10 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <string>
 
+#include "io/srgb_encode.h"
 #include "visopt/error.h"
 #include "visopt/image.h"
 
@@ -67,6 +69,50 @@ TEST(Image, Srgb8EncodesKnownValues) {
   EXPECT_EQ(s[12], 1);
   EXPECT_EQ(s[13], 128);
   EXPECT_EQ(s[14], 254);
+}
+
+// The fast sRGB encoder (the path toSrgb8 takes) gives the formula's code exactly: on the floats
+// next to every code's step (found by bisection on the formula), out-of-range values, NaN and
+// infinities, denormals and random values; writeSrgb8 into padded rows gives toSrgb8's bytes.
+TEST(Image, TheFastSrgbEncoderEqualsTheFormula) {
+  const io::SrgbEncoder& fast = io::SrgbEncoder::instance();
+  std::vector<float> values = {0.f,
+                               -0.f,
+                               1.f,
+                               2.f,
+                               -1.f,
+                               std::nanf(""),
+                               std::numeric_limits<float>::infinity(),
+                               -std::numeric_limits<float>::infinity(),
+                               std::numeric_limits<float>::denorm_min(),
+                               0.0031308f,
+                               std::nextafter(0.0031308f, 1.f)};
+  for (int k = 1; k <= 255; ++k) {
+    float lo = 0.f, hi = 1.f;
+    for (int i = 0; i < 60; ++i) {
+      const float mid = 0.5f * (lo + hi);
+      (io::encodeSrgbReference(mid) >= k ? hi : lo) = mid;
+    }
+    float v = std::nextafter(lo, 0.f);
+    for (int n = 0; n < 4; ++n, v = std::nextafter(v, 2.f)) values.push_back(v);
+  }
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-0.1f, 1.1f);
+  for (int i = 0; i < 200000; ++i) values.push_back(unit(rng) * unit(rng));
+  size_t differing = 0;
+  for (float v : values) differing += fast(v) != io::encodeSrgbReference(v);
+  EXPECT_EQ(differing, 0u);
+
+  Image img(7, 5);
+  for (size_t i = 0; i < img.pixels.size(); ++i)
+    img.pixels[i] = {values[i], values[i + 40], values[i + 400]};
+  const std::vector<uint8_t> packed = img.toSrgb8();
+  std::vector<uint8_t> padded(5 * 40, 0xab);
+  img.writeSrgb8(padded.data(), 40);
+  for (int y = 0; y < 5; ++y)
+    for (int b = 0; b < 40; ++b)
+      EXPECT_EQ(padded[size_t(y) * 40 + b], b < 28 ? packed[size_t(y) * 28 + b] : 0xab)
+          << y << "," << b;
 }
 
 TEST(Image, PngRoundTripIsExactOnCodes) {

@@ -13,8 +13,7 @@ namespace visopt::ws {
 // height and focusPixel (the members a session stores).
 bool sameHotspotSettings(const ClearViewSettings& a, const ClearViewSettings& b);
 
-// `image` as 8-bit sRGB, byte for byte what Image::toSrgb8 gives, in a fraction of its time: a
-// table lookup and a comparison per channel instead of a pow, rows in parallel.
+// `image` as 8-bit sRGB (Image::writeSrgb8) straight into the QImage the viewport paints.
 QImage toDisplayImage(const Image& image);
 
 }  // namespace visopt::ws

@@ -17,10 +17,7 @@ namespace {
 
 QImage toQImage(const Image& image) {
   QImage out(image.width, image.height, QImage::Format_RGBA8888);
-  const auto rgba = image.toSrgb8();
-  for (int y = 0; y < image.height; ++y)
-    std::memcpy(out.scanLine(y), rgba.data() + size_t(y) * size_t(image.width) * 4,
-                size_t(image.width) * 4);
+  if (!out.isNull()) image.writeSrgb8(out.bits(), size_t(out.bytesPerLine()));
   return out;
 }
 

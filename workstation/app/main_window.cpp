@@ -20,6 +20,7 @@
 #include <QMessageBox>
 #include <QProgressDialog>
 #include <QSaveFile>
+#include <QScrollArea>
 #include <QShowEvent>
 #include <QStatusBar>
 #include <QTabBar>
@@ -218,7 +219,13 @@ void MainWindow::buildDocks() {
   auto* dSurf = dock(tr("Surfaces"), surfacesPanel_, Qt::RightDockWidgetArea);
   auto* dOpt = dock(tr("Optimisation"), optimizationPanel_, Qt::RightDockWidgetArea);
   auto* dDev = dock(tr("Deviation"), deviationPanel_, Qt::RightDockWidgetArea);
-  auto* dHot = dock(tr("Hotspot"), hotspotPanel_, Qt::RightDockWidgetArea);
+  // The Hotspot panel is the tallest: it scrolls rather than make the window taller than the
+  // screen (or than --size asks).
+  auto* hotspotScroll = new QScrollArea(this);
+  hotspotScroll->setWidget(hotspotPanel_);
+  hotspotScroll->setWidgetResizable(true);
+  hotspotScroll->setFrameShape(QFrame::NoFrame);
+  auto* dHot = dock(tr("Hotspot"), hotspotScroll, Qt::RightDockWidgetArea);
   comparisonDock_ = dock(tr("Comparison"), comparisonView_, Qt::BottomDockWidgetArea);
   comparisonDock_->hide();
   panels_ = {dTf, dImp, dSurf, dOpt, dDev, dHot};

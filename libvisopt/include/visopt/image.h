@@ -19,6 +19,8 @@ struct Image {
   const glm::vec3& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
   // 8-bit sRGB, RGBA interleaved.
   std::vector<uint8_t> toSrgb8() const;
+  // The same into rows of `bytesPerRow` bytes (>= 4 * width) at `rgba` (e.g. a GUI's image).
+  void writeSrgb8(uint8_t* rgba, size_t bytesPerRow) const;
 };
 
 // Writes an 8-bit sRGB PNG atomically (temporary file, then rename). Throws Error(Failure).

@@ -1,6 +1,6 @@
 // Image <-> 8-bit sRGB PNG through libpng's simplified API, and PSNR.
 //  - toSrgb8: the sRGB OETF (IEC 61966-2-1) of each clamped linear channel, rounded; NaN -> 0;
-//    alpha 255.
+//    alpha 255 (io/srgb_encode.h: the fast encoder, equal code for code to the formula).
 //  - writePng: RGBA8 written to a temporary sibling, then renamed (Error(Failure) on any problem,
 //    Error(Usage) for an empty image).
 //  - readPng: any PNG libpng can convert to 8-bit RGB, decoded to linear with the inverse OETF
@@ -17,21 +17,17 @@
 #include <limits>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "io/file_util.h"
+#include "io/srgb_encode.h"
 #include "visopt/error.h"
 #include "visopt/image.h"
 
 namespace visopt {
 
 namespace {
-
-uint8_t encodeSrgb(float linear) {
-  if (!(linear > 0.f)) return 0;  // also NaN
-  if (linear >= 1.f) return 255;
-  const float e =
-      linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.f / 2.4f) - 0.055f;
-  return static_cast<uint8_t>(std::lround(std::clamp(e, 0.f, 1.f) * 255.f));
-}
 
 const std::array<float, 256>& decodeTable() {
   static const std::array<float, 256> table = [] {
@@ -49,13 +45,25 @@ const std::array<float, 256>& decodeTable() {
 
 std::vector<uint8_t> Image::toSrgb8() const {
   std::vector<uint8_t> out(pixels.size() * 4);
-  for (size_t i = 0; i < pixels.size(); ++i) {
-    out[4 * i + 0] = encodeSrgb(pixels[i].r);
-    out[4 * i + 1] = encodeSrgb(pixels[i].g);
-    out[4 * i + 2] = encodeSrgb(pixels[i].b);
-    out[4 * i + 3] = 255;
-  }
+  writeSrgb8(out.data(), size_t(width) * 4);
   return out;
+}
+
+void Image::writeSrgb8(uint8_t* rgba, size_t bytesPerRow) const {
+  if (pixels.size() != size_t(width) * size_t(height)) return;
+  const io::SrgbEncoder& encode = io::SrgbEncoder::instance();
+  tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y != r.end(); ++y) {
+      uint8_t* line = rgba + size_t(y) * bytesPerRow;
+      const glm::vec3* in = pixels.data() + size_t(y) * size_t(width);
+      for (int x = 0; x < width; ++x) {
+        line[4 * x + 0] = encode(in[x].r);
+        line[4 * x + 1] = encode(in[x].g);
+        line[4 * x + 2] = encode(in[x].b);
+        line[4 * x + 3] = 255;
+      }
+    }
+  });
 }
 
 void checkPngOutput(const std::string& path) {

@@ -272,9 +272,15 @@ void EngineController::renderFrame(Engine& engine, bool preview) {
     return;
   }
   info.renderMs = stats.milliseconds;
+  frameDone(image, info, preview, owedAt);
+}
+
+void EngineController::frameDone(const QImage& image, const FrameInfo& info, bool preview,
+                                 uint64_t owedAt) {
   {
     std::lock_guard lock(mutex_);
     previewShown_ = preview;
+    // A full frame settles what was owed when it started; a newer request stays owed.
     if (!preview && owedSerial_ == owedAt) frameOwed_ = false;
   }
   sinceFrame_.restart();

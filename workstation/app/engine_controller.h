@@ -134,6 +134,8 @@ class EngineController : public QObject {
   // the same settings and nothing changed since); false: render the normal frame.
   bool renderClearViewFrame(Engine& engine, bool preview);
   void deliver(std::function<void()> onUiThread);  // queued to the UI thread
+  // A rendered frame to the UI; `owedAt`: the owed-frame serial when its render started.
+  void frameDone(const QImage& image, const FrameInfo& info, bool preview, uint64_t owedAt);
 
   const Precision precision_;
   std::thread worker_;

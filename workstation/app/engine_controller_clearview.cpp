@@ -101,14 +101,7 @@ bool EngineController::renderClearViewFrame(Engine& engine, bool preview) {
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   info.clearView = true;
   info.clearViewStats = stats;
-  {
-    std::lock_guard lock(mutex_);
-    previewShown_ = preview;
-    if (!preview && owedSerial_ == owedAt) frameOwed_ = false;
-  }
-  sinceFrame_.restart();
-  itersSinceFrame_ = 0;
-  deliver([this, image, info] { emit frameReady(image, info); });
+  frameDone(image, info, preview, owedAt);
   return true;
 }
 

@@ -18,21 +18,11 @@
 #include <QVBoxLayout>
 
 #include "panels/context_surfaces_panel.h"  // describeSurfaceSource
+#include "widgets/spin_boxes.h"
 
 namespace visopt::ws {
 
 namespace {
-
-QDoubleSpinBox* makeBox(QWidget* parent, const char* name, double lo, double hi, int decimals,
-                        double step) {
-  auto* box = new QDoubleSpinBox(parent);
-  box->setObjectName(QString::fromLatin1(name));
-  box->setRange(lo, hi);
-  box->setDecimals(decimals);
-  box->setSingleStep(step);
-  box->setKeyboardTracking(false);  // one edit per Enter / focus change, not per keystroke
-  return box;
-}
 
 QComboBox* makeShaderBox(QWidget* parent, const char* name) {
   auto* box = new QComboBox(parent);
@@ -187,14 +177,14 @@ HotspotLayerEditor::HotspotLayerEditor(const QString& role, QWidget* parent) : Q
   auto* isoPage = new QWidget(pages_);
   auto* isoLayout = new QVBoxLayout(isoPage);
   isoLayout->setContentsMargins(0, 0, 0, 0);
-  isovalue_ = makeBox(isoPage, "isovalue", 0.0, 1.0, 3, 0.01);
+  isovalue_ = makeDoubleBox(isoPage, "isovalue", 0.0, 1.0, 3, 0.01);
   picker_ = new IsovaluePicker(isoPage);
   picker_->setObjectName(QStringLiteral("isoPicker"));
   isoLayout->addWidget(isovalue_);
   isoLayout->addWidget(picker_);
   page(isoPage);
 
-  level_ = makeBox(pages_, "importanceLevel", 0.001, 1.0, 3, 0.05);
+  level_ = makeDoubleBox(pages_, "importanceLevel", 0.001, 1.0, 3, 0.05);
   level_->setValue(0.5);
   level_->setToolTip(
       tr("The importance's isosurface at this level g, in (0, 1] (unitless; inside where "
@@ -356,7 +346,7 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
   // --- Hotspot ---
   auto* hotspot = new QGroupBox(tr("Hotspot"), this);
   auto* hotspotForm = new QFormLayout(hotspot);
-  size_ = makeBox(hotspot, "size", 0.0, 1000.0, 2, 1.0);
+  size_ = makeDoubleBox(hotspot, "size", 0.0, 1000.0, 2, 1.0);
   size_->setSpecialValueText(tr("automatic"));
   size_->setSuffix(tr(" mm"));
   size_->setToolTip(
@@ -374,12 +364,12 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
          "image-space curvature (§3.2.1; the default), its distance to the focus surface along "
          "its normal (§3.2.2) or along the view ray (§3.2.3)."));
   hotspotForm->addRow(tr("Measure"), measure_);
-  weight_ = makeBox(hotspot, "weight", 0.0, 100.0, 2, 0.1);
+  weight_ = makeDoubleBox(hotspot, "weight", 0.0, 100.0, 2, 0.1);
   weight_->setToolTip(
       tr("The measure's weight against the distance term, >= 0 (unitless): 0 opens a plain "
          "sphere, larger values keep more of the curved context. Default: 1."));
   hotspotForm->addRow(tr("Weight"), weight_);
-  distanceScale_ = makeBox(hotspot, "distanceScale", 0.0, 1e6, 2, 1.0);
+  distanceScale_ = makeDoubleBox(hotspot, "distanceScale", 0.0, 1e6, 2, 1.0);
   distanceScale_->setSpecialValueText(tr("= size"));
   distanceScale_->setSuffix(tr(" mm"));
   distanceScale_->setToolTip(
@@ -406,7 +396,7 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
   focusShader_->setToolTip(
       tr("The focus layer's shader: diffuse, cool to warm, skin or bone. Default: bone."));
   shadingForm->addRow(tr("Focus shader"), focusShader_);
-  ambient_ = makeBox(shading, "ambient", 0.0, 1.0, 2, 0.05);
+  ambient_ = makeDoubleBox(shading, "ambient", 0.0, 1.0, 2, 0.05);
   ambient_->setToolTip(
       tr("The ambient term of the diffuse and cool-to-warm shaders, 0..1 (unitless). "
          "Default: 0.15."));

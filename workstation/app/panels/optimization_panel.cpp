@@ -12,20 +12,11 @@
 #include <QSpinBox>
 #include <QVBoxLayout>
 
+#include "widgets/spin_boxes.h"
+
 namespace visopt::ws {
 
 namespace {
-
-QDoubleSpinBox* makeDoubleBox(QWidget* parent, const char* name, double lo, double hi, int decimals,
-                              double step) {
-  auto* box = new QDoubleSpinBox(parent);
-  box->setObjectName(QString::fromLatin1(name));
-  box->setRange(lo, hi);
-  box->setDecimals(decimals);
-  box->setSingleStep(step);
-  box->setKeyboardTracking(false);  // one edit per Enter / focus change, not per keystroke
-  return box;
-}
 
 QSpinBox* makeIntBox(QWidget* parent, const char* name, int lo, int hi) {
   auto* box = new QSpinBox(parent);

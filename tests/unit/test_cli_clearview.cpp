@@ -273,4 +273,10 @@ TEST(CliClearView, ASessionsHotspotSettingsAreTheDefaults) {
   j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["clearview"]["measure"], "distance");
   EXPECT_EQ(j["clearview"]["context"], "iso:0.37");
+  // session-info says what the hotspot will show.
+  r = run("session-info " + session);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("hotspot:     iso:0.37 over importance:0.5, view-distance"),
+            std::string::npos)
+      << r.out;
 }

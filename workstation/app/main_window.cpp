@@ -228,7 +228,7 @@ void MainWindow::buildDocks() {
   auto* dHot = dock(tr("Hotspot"), hotspotScroll, Qt::RightDockWidgetArea);
   comparisonDock_ = dock(tr("Comparison"), comparisonView_, Qt::BottomDockWidgetArea);
   comparisonDock_->hide();
-  panels_ = {dTf, dImp, dSurf, dOpt, dDev, dHot};
+  panels_ = {dTf, dImp, dSurf, dOpt, dDev, dHot};  // the Hotspot panel last (chooseTool)
   arrangePanels();
 
   // Editors -> engine.
@@ -1046,9 +1046,10 @@ void MainWindow::chooseTool(QAction* action) {
     viewport_->setTool(lensTool_);
   else if (action == actWindow_)
     viewport_->setTool(windowTool_);
-  else if (action == actHotspot_)
+  else if (action == actHotspot_) {
     viewport_->setTool(hotspotTool_);
-  else
+    panels_.back()->raise();  // the Hotspot panel: its settings are what the view now shows
+  } else
     viewport_->setTool(nullptr);
   if (action == actLens_) lensTool_->setLensOn(true);
 }

@@ -1,6 +1,7 @@
 // visopt session-info FILE: what a session holds and whether its data files are where it says.
 #include <cstdio>
 
+#include "clearview_spec.h"
 #include "cli_common.h"
 #include "commands.h"
 #include "visopt/session.h"
@@ -76,7 +77,12 @@ Runner addSessionInfoCommand(CLI::App& app) {
     std::printf("precision:   %s\n", toString(s.precision));
     std::printf("transfer fn: %s\n",
                 s.transferFunction ? s.transferFunction->name.c_str() : "(the data's default)");
-    std::printf("importance:  %s\n", toString(s.importance.kind));
+    if (s.importance.kind == ImportanceKind::Hotspot)
+      std::printf("importance:  hotspot, a ball of radius %g about %g,%g,%g\n",
+                  double(s.importance.hotspotRadius), double(s.importance.hotspotCentre.x),
+                  double(s.importance.hotspotCentre.y), double(s.importance.hotspotCentre.z));
+    else
+      std::printf("importance:  %s\n", toString(s.importance.kind));
     for (size_t i = 0; i < s.contextSurfaces.size(); ++i)
       std::printf("surface %zu:   %s%s\n", i + 1, s.contextSurfaces[i].spec.source.c_str(),
                   s.contextSurfaces[i].spec.visible ? "" : " (hidden)");
@@ -85,6 +91,13 @@ Runner addSessionInfoCommand(CLI::App& app) {
                   double(s.camera->eye.y), double(s.camera->eye.z), double(s.camera->target.x),
                   double(s.camera->target.y), double(s.camera->target.z));
     std::printf("frozen:      %s\n", s.frozen ? "yes" : "no");
+    if (s.clearView)
+      std::printf(
+          "hotspot:     %s over %s, %s, shaders %s / %s, size %s\n",
+          describeClearViewLayer(s.clearView->context).c_str(),
+          describeClearViewLayer(s.clearView->focus).c_str(), toString(s.clearView->measure),
+          toString(s.clearView->contextShader), toString(s.clearView->focusShader),
+          s.clearView->size > 0.f ? std::to_string(s.clearView->size).c_str() : "automatic");
     if (s.worldMask)
       std::printf("world mask:  %d x %d x %d, %zu voxels set\n", s.worldMask->dims.x,
                   s.worldMask->dims.y, s.worldMask->dims.z, maskSet);

@@ -146,7 +146,11 @@ VISOPT_HD inline glm::vec3 clearViewNormal(const ClearViewSurfaceField& s, const
 struct ClearViewExtractKernel {
   ClearViewExtractParams p;
 
-  // One pixel; returns the number of layers hit (for the caller's statistics).
+  // A context hit counts 1 and a focus hit kFocusHit in the value a pixel returns, so that one
+  // sum over the image gives both layers' pixel counts (at most 16384^2 < 2^32 pixels).
+  static constexpr int64_t kFocusHit = int64_t(1) << 32;
+
+  // One pixel; returns its hits as above.
   VISOPT_HD int64_t operator()(int64_t pixel) const {
     const int w = p.camera.dims.x, h = p.camera.dims.y;
     const int px = int(pixel % w), row = int(pixel / w);
@@ -188,7 +192,7 @@ struct ClearViewExtractKernel {
       glm::vec3 n = clearViewNormal(p.focus, p.volume, idx);
       if (n == glm::vec3(0.f)) n = -dirWorld;
       p.focusOut.normal[pixel] = n;
-      ++hits;
+      hits += kFocusHit;
     } else {
       tf = kClearViewNoHit;
       p.focusOut.position[pixel] = glm::vec3(0.f);

@@ -136,15 +136,10 @@ void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>&
     p.volumeOut = out.volume.data();
   }
   const ClearViewExtractKernel kernel{p};
-  exec::reduce("clearview: extract", int64_t(n), int64_t(0), kernel,
-               [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
-  int64_t c = 0, f = 0;
-  for (size_t i = 0; i < n; ++i) {
-    c += out.contextDepth[i] < kClearViewNoHit;
-    f += out.focusDepth[i] < kClearViewNoHit;
-  }
-  out.contextPixels = c;
-  out.focusPixels = f;
+  const int64_t hits = exec::reduce("clearview: extract", int64_t(n), int64_t(0), kernel,
+                                    [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+  out.contextPixels = hits % ClearViewExtractKernel::kFocusHit;
+  out.focusPixels = hits / ClearViewExtractKernel::kFocusHit;
 }
 
 namespace {

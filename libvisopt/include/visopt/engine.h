@@ -140,6 +140,16 @@ class Engine {
   std::vector<IterationStats> continueOptimization(
       int iterations, const std::function<bool(const IterationStats&)>& callback = {},
       const std::function<bool()>& abandon = {});
+  // While the camera moves (Himmler & Günther 2026, §III-F: the optimisation adjusts to new
+  // viewpoints during navigation): iterations on the coarsest multigrid level
+  // (ExtinctionSettings::levels) for the current camera, their change to mu and the surfaces
+  // prolonged onto the finest level, at a small fraction of a finest iteration's cost; the
+  // finest level then refines with continueOptimization() once the camera rests. Stats carry
+  // level 0. Does nothing while frozen. `abandon` as for optimize(): an abandoned iteration
+  // changes nothing.
+  std::vector<IterationStats> followCamera(
+      int iterations, const std::function<bool(const IterationStats&)>& callback = {},
+      const std::function<bool()>& abandon = {});
   // A frozen result keeps its mu when the camera moves (Himmler & Günther 2026, §III-F, Fig. 7).
   void setFrozen(bool frozen);
   bool frozen() const;

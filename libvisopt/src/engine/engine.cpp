@@ -694,6 +694,19 @@ std::vector<IterationStats> Engine::continueOptimization(
   return stats;
 }
 
+std::vector<IterationStats> Engine::followCamera(
+    int iterations, const std::function<bool(const IterationStats&)>& callback,
+    const std::function<bool()>& abandon) {
+  if (impl_->frozen || iterations <= 0) return {};
+  auto stats = impl_->optimizer.follow(impl_->optimizationInputs(), impl_->extinctionSettings,
+                                       iterations, callback, abandon);
+  if (!stats.empty()) {  // the finest mu and surfaces changed by the correction
+    impl_->muChanged = true;
+    ++impl_->sceneRevision;
+  }
+  return stats;
+}
+
 void Engine::setFrozen(bool frozen) {
   impl_->frozen = frozen;
 }

@@ -19,7 +19,9 @@
 #include "kernels/visibility_scan_fast.h"
 #include "optimize/level_end.h"
 #include "optimize/level_set.h"
+#include "optimize/multigrid_transfer.h"
 #include "optimize/narrow_band.h"
+#include "optimize/optimizer_level.h"
 #include "optimize/scan_skip_grid.h"
 #include "visopt/error.h"
 
@@ -151,59 +153,6 @@ std::vector<float> analyticGradient(const ExtinctionProblem& p, Precision precis
 
 // ---- the optimiser ---------------------------------------------------------------------------
 
-namespace {
-
-// What ghat (Eq. 19) is computed from besides the level's grid: the frusta it gathers the maxima
-// of g along, and the revision of the importance and the screen weights.
-struct ImportanceBehindInputs {
-  FrustumGrid view, light;
-  uint64_t importanceRevision = 0;
-};
-
-bool operator==(const ImportanceBehindInputs& a, const ImportanceBehindInputs& b) {
-  return a.view == b.view && a.light == b.light && a.importanceRevision == b.importanceRevision;
-}
-
-}  // namespace
-
-struct ExtinctionOptimizer::Level {
-  int index = 0;
-  bool finest = false;
-  GridSpec grid;
-  std::optional<Field3D> mu, base, importance;  // base/importance only on coarse levels
-  std::optional<Field3D> m1, m2, rms;
-  std::optional<Field3D> dView, dLight;
-  // Context surfaces: phi per surface, phi0 on coarse levels (the finest uses the inputs'),
-  // the world mask on coarse levels, ghat, the frustum maxima of g and level-set scratch.
-  std::vector<Field3D> phi, phi0;
-  std::vector<NarrowBand> bands;  // per surface: the narrow band of the level-set numerics
-  std::optional<DeviceBitMask> mask;
-  std::optional<Field3D> ghat, viewMax, lightMax, scratch;
-  FrustumGrid view, light;
-  int shrink = 1;  // frustum grids are this many times coarser than at the finest level
-  int t = 0;       // optimiser steps taken on this level
-  float gradientScale = 1.f;
-  double motionSinceRedistance = 0.0;  // bound on the surfaces' motion since the last redistancing
-  int substeps = 0;                    // level-set substeps per iteration (LevelSetSettings::reach)
-  double insideRiseSinceRedistance = 0.0;  // bound on the inside's rise (LevelSetStepStats)
-  double lastMotion = 0.0;  // bound on how far the surfaces moved in the last iteration, world
-                            // units
-  double lastEnergy = 0.0;
-  // The semi-implicit integrator's last chunk (substeps' time per step), where the next
-  // iteration starts: a chunk costs the same whatever its length, so restarting each iteration
-  // from `substeps` would double the steps of a level whose surfaces move slowly.
-  int semiImplicitChunk = 0;
-  // ghat (Eq. 19) depends on the importance, the view and light frusta and the screen weights
-  // only: while they stay what `ghatFor` records (within a run, and between the workstation's
-  // iterations while the camera rests), the frustum maxima of g, the importance-behind gather
-  // and the fixed-brick marks are not redone.
-  std::optional<ImportanceBehindInputs> ghatFor;  // what ghat was last computed for
-  // The side of every surface each voxel lay on when this iteration's level-set steps began
-  // (bit set: inside, phi < 0), 64 voxels per word.
-  std::vector<DeviceBuffer<uint64_t>> insideAtStart;
-  ScanSkipStorage scanSkip;  // the grid updates' empty space, rebuilt every iteration
-};
-
 ExtinctionOptimizer::ExtinctionOptimizer(MemoryLedger* ledger, Precision precision)
     : ledger_(ledger), precision_(precision) {}
 ExtinctionOptimizer::~ExtinctionOptimizer() = default;
@@ -214,6 +163,7 @@ const Field3D* ExtinctionOptimizer::extinction() const {
 
 void ExtinctionOptimizer::reset() {
   level_.reset();
+  follower_.reset();
 }
 
 std::vector<const Field3D*> ExtinctionOptimizer::surfaces() const {
@@ -229,92 +179,9 @@ const Field3D* ExtinctionOptimizer::importanceBehind() const {
 
 namespace {
 
-GridSpec levelGrid(const GridSpec& fine, int factor) {
-  if (factor <= 1) return fine;
-  GridSpec g = fine;
-  for (int a = 0; a < 3; ++a) {
-    if (fine.dims[a] <= 2) continue;
-    g.dims[a] = std::max(2, (fine.dims[a] - 1 + factor - 1) / factor + 1);
-    g.spacing[a] = fine.spacing[a] * float(fine.dims[a] - 1) / float(g.dims[a] - 1);
-  }
-  return g;
-}
-
 struct DeviationSums {
   double sum = 0, max = 0, count = 0;
 };
-
-// Trilinear resampling of `src` (on the grid `srcMap`) onto `dst`'s grid.
-void resample(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
-  const FieldView from(src), to(dst);
-  const GridMap map(dst.grid());
-  exec::parallelFor("multigrid resample", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
-    const auto [i, j, k] = map.ijk(v);
-    to.store(size_t(v),
-             from.sample(srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))))));
-  });
-}
-
-// The world mask on a coarser grid: a coarse voxel is masked where the trilinear interpolation
-// of the fine 0/1 mask at its centre exceeds 0.5 (what resampling the mask as a field and
-// thresholding it gave). One work item per output byte, so no two write the same word.
-void resampleMask(const DeviceBitMask& src, const GridMap& srcMap, DeviceBitMask& dst,
-                  const GridSpec& dstGrid) {
-  const BitMaskView from = src.view();
-  uint8_t* to = dst.words();
-  const GridMap map(dstGrid);
-  const int64_t voxels = int64_t(dstGrid.voxelCount());
-  exec::parallelFor("multigrid resample mask", int64_t(dst.bytes()), [=] VISOPT_HD(int64_t b) {
-    unsigned word = 0;
-    for (int bit = 0; bit < 8; ++bit) {
-      const int64_t v = b * 8 + bit;
-      if (v >= voxels) break;
-      const auto [i, j, k] = map.ijk(v);
-      const glm::vec3 p = srcMap.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))));
-      if (from.sample(p) > 0.5f) word |= 1u << bit;
-    }
-    to[b] = static_cast<uint8_t>(word);
-  });
-}
-
-// Prolongation of a surface's deviation: phi_fine = phi0_fine + (phi_coarse - phi0_coarse),
-// trilinear. Prolonging phi itself would replace the fine base shape by the coarse level's
-// blurred (min-restricted) one wherever nothing moved, leaving voxel-scale ripples for the slow
-// return term to remove.
-void prolongDeviation(const Field3D& phiCoarse, const Field3D& baseCoarse, const GridMap& coarse,
-                      const Field3D& baseFine, Field3D& phiFine) {
-  const FieldView pc(phiCoarse), bc(baseCoarse), bf(baseFine), out(phiFine);
-  const GridMap map(phiFine.grid());
-  exec::parallelFor("multigrid prolong sdf", int64_t(phiFine.size()), [=] VISOPT_HD(int64_t v) {
-    const auto [i, j, k] = map.ijk(v);
-    const glm::vec3 q = coarse.toIndex(map.toWorld(glm::vec3(float(i), float(j), float(k))));
-    out.store(size_t(v), bf.load(size_t(v)) + (pc.sample(q) - bc.sample(q)));
-  });
-}
-
-// Restriction of an SDF to a coarser grid: the minimum over 3^3 points spread over each coarse
-// voxel, so a surface thinner than a coarse voxel (a skull, a thin shell) does not vanish from
-// the coarse levels, where it would otherwise let the view through.
-// The world position of sample c (0..26) of the 3^3 samples that restriction takes in coarse
-// voxel (i, j, k): the voxel's centre and the points a third of a voxel from it along each axis.
-VISOPT_HD VISOPT_INLINE glm::vec3 restrictionSample(const GridMap& coarse, int i, int j, int k,
-                                                    int c) {
-  const glm::vec3 off(float(c % 3 - 1), float((c / 3) % 3 - 1), float(c / 9 - 1));
-  return coarse.toWorld(glm::vec3(float(i), float(j), float(k)) + off / 3.f);
-}
-constexpr int kRestrictionSamples = 27;
-
-void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
-  const FieldView from(src), to(dst);
-  const GridMap map(dst.grid());
-  exec::parallelFor("multigrid restrict sdf", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
-    const auto [i, j, k] = map.ijk(v);
-    float m = 3.0e38f;
-    for (int c = 0; c < kRestrictionSamples; ++c)
-      m = fminf(m, from.sample(srcMap.toIndex(restrictionSample(map, i, j, k, c))));
-    to.store(size_t(v), m);
-  });
-}
 
 // The lens and windowing mask of the view rays (Himmler & Günther 2026, §III-F, Fig. 8).
 ScreenWeights screenWeightsOf(const OptimizationInputs& in) {
@@ -352,6 +219,8 @@ int levelSetSubsteps(const OptimizationInputs& in, const ExtinctionSettings& s,
   return int(std::clamp(n, double(least), 4096.0));
 }
 
+}  // namespace
+
 float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s, Precision p) {
   float m = s.muMax > 0.f ? s.muMax : in.transferMaxExtinction;
   if (!(m > 0.f)) m = 1.f;
@@ -360,10 +229,8 @@ float levelMuMax(const OptimizationInputs& in, const ExtinctionSettings& s, Prec
   return p == Precision::FP16 ? std::min(m, 1e4f) : m;
 }
 
-}  // namespace
-
-void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const ExtinctionSettings& s,
-                                     int index, int levels) {
+std::unique_ptr<ExtinctionOptimizer::Level> ExtinctionOptimizer::newLevel(
+    const OptimizationInputs& in, int index, int levels, const std::string& suffix) {
   const GridSpec& fine = in.volume->grid();
   const int factor = 1 << (levels - 1 - index);
   auto next = std::make_unique<Level>();
@@ -372,31 +239,48 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
   next->grid = levelGrid(fine, factor);
   next->shrink = factor;
   const GridSpec grid = next->grid;
-  next->mu.emplace("extinction", grid, precision_, ledger_);
-  FieldView mu(*next->mu);
-  const GridMap map(grid);
-
+  const auto name = [&](const char* what) { return what + suffix; };
+  next->mu.emplace(name("extinction"), grid, precision_, ledger_);
+  const GridMap fineMap(fine);
   if (!next->finest) {
     // Coarse mu_bar and g: averages of the fine fields over each coarse voxel (3^3 samples).
-    next->base.emplace("extinction-base (coarse)", grid, precision_, ledger_);
-    next->importance.emplace("importance (coarse)", grid, precision_, ledger_);
-    FieldView base(*next->base), imp(*next->importance);
-    FieldView scalars(in.volume->normalized), fineImp(*in.importance);
-    TransferLookup tf = lookupOf(in.transfer);
-    const GridMap fineMap(fine);
-    exec::parallelFor("multigrid restrict", int64_t(grid.voxelCount()), [=] VISOPT_HD(int64_t v) {
-      const auto [i, j, k] = map.ijk(v);
-      float b = 0.f, g = 0.f;
-      for (int c = 0; c < kRestrictionSamples; ++c) {
-        const glm::vec3 fi = fineMap.toIndex(restrictionSample(map, i, j, k, c));
-        b += tf.at(scalars.sample(fi)).w;
-        g += fineImp.sample(fi);
-      }
-      base.store(size_t(v), b / float(kRestrictionSamples));
-      imp.store(size_t(v), g / float(kRestrictionSamples));
-    });
+    next->base.emplace(name("extinction-base (coarse)"), grid, precision_, ledger_);
+    next->importance.emplace(name("importance (coarse)"), grid, precision_, ledger_);
+    restrictBaseAndImportance(in.volume->normalized, *in.transfer, *in.importance, fineMap,
+                              *next->base, *next->importance);
   }
+  // Context surfaces: phi0 restricted onto coarse levels (the finest uses the inputs').
+  for (size_t si = 0; si < in.surfaceBases.size(); ++si) {
+    if (!next->finest) {
+      next->phi0.emplace_back(name("surface-base (coarse)"), grid, precision_, ledger_);
+      restrictSdf(*in.surfaceBases[si], fineMap, next->phi0.back());
+      // The min-restriction is not a distance field; redistance it once here so that the
+      // level's own redistancing does not move its surface (which the next level would inherit
+      // as a deviation).
+      Field3D scratch("surface-scratch", grid, precision_, nullptr);
+      redistance(next->phi0.back(), in.levelSet, scratch);
+    }
+    next->phi.emplace_back(name("surface"), grid, precision_, ledger_);
+  }
+  next->bands.resize(next->phi.size());
+  if (!in.surfaceBases.empty()) {
+    next->ghat.emplace(name("importance-behind"), grid, precision_, ledger_);
+    next->scratch.emplace(name("surface-scratch"), grid, precision_, ledger_);
+    if (in.worldMask && !next->finest) {
+      next->mask.emplace(grid.dims, name("world-mask (coarse)"), ledger_);
+      resampleMask(*in.worldMask, fineMap, *next->mask, grid);
+    }
+  }
+  return next;
+}
 
+void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const ExtinctionSettings& s,
+                                     int index, int levels) {
+  follower_.reset();  // restricted from a state this replaces
+  std::unique_ptr<Level> next = newLevel(in, index, levels);
+  const GridSpec grid = next->grid;
+  FieldView mu(*next->mu);
+  const GridMap map(grid);
   if (level_ && level_->mu) {
     // Prolong the previous level's mu (trilinear).
     FieldView coarse(*level_->mu);
@@ -415,52 +299,30 @@ void ExtinctionOptimizer::buildLevel(const OptimizationInputs& in, const Extinct
     exec::parallelFor("extinction init", int64_t(grid.voxelCount()),
                       [=] VISOPT_HD(int64_t v) { mu.store(size_t(v), base.at(size_t(v))); });
   }
-  // Context surfaces: phi0 resampled onto coarse levels, phi prolonged from the previous level
-  // (or phi0 at the first level).
-  const GridMap fineMap(fine);
-  for (size_t si = 0; si < in.surfaceBases.size(); ++si) {
-    const Field3D& base = *in.surfaceBases[si];
-    if (!next->finest) {
-      next->phi0.emplace_back("surface-base (coarse)", grid, precision_, ledger_);
-      restrictSdf(base, fineMap, next->phi0.back());
-      // The min-restriction is not a distance field; redistance it once here so that the
-      // level's own redistancing does not move its surface (which the next level would inherit
-      // as a deviation).
-      Field3D scratch("surface-scratch", grid, precision_, nullptr);
-      redistance(next->phi0.back(), in.levelSet, scratch);
-    }
-    next->phi.emplace_back("surface", grid, precision_, ledger_);
+  // phi prolonged from the previous level (its deviation from its base), or phi0 at the first.
+  const GridMap fineMap(in.volume->grid());
+  for (size_t si = 0; si < next->phi.size(); ++si) {
+    const Field3D& base = next->finest ? *in.surfaceBases[si] : next->phi0[si];
     if (level_ && si < level_->phi.size() && si < level_->phi0.size())
-      prolongDeviation(level_->phi[si], level_->phi0[si], GridMap(level_->grid),
-                       next->finest ? base : next->phi0.back(), next->phi.back());
+      prolongDeviation(level_->phi[si], level_->phi0[si], GridMap(level_->grid), base,
+                       next->phi[si]);
     else if (level_ && si < level_->phi.size())
-      resample(level_->phi[si], GridMap(level_->grid), next->phi.back());
+      resample(level_->phi[si], GridMap(level_->grid), next->phi[si]);
     else
-      resample(next->finest ? base : next->phi0.back(), next->finest ? fineMap : map,
-               next->phi.back());
-  }
-  next->bands.resize(next->phi.size());
-  if (!in.surfaceBases.empty()) {
-    next->ghat.emplace("importance-behind", grid, precision_, ledger_);
-    next->scratch.emplace("surface-scratch", grid, precision_, ledger_);
-    if (in.worldMask && !next->finest) {
-      next->mask.emplace(grid.dims, "world-mask (coarse)", ledger_);
-      resampleMask(*in.worldMask, fineMap, *next->mask, grid);
-    }
+      resample(base, next->finest ? fineMap : map, next->phi[si]);
   }
   level_.reset();
   level_ = std::move(next);
   (void)s;
 }
 
-std::optional<IterationStats> ExtinctionOptimizer::runIteration(const OptimizationInputs& in,
+std::optional<IterationStats> ExtinctionOptimizer::runIteration(Level& L,
+                                                                const OptimizationInputs& in,
                                                                 const ExtinctionSettings& s,
-                                                                int levels, int cap) {
+                                                                int cap) {
   cutShort_ = false;
   if (abandonRequested()) return std::nullopt;
-  Level& L = *level_;
   const int shrink = L.shrink;
-  (void)levels;
   const Bounds bounds = in.volume->grid().worldBounds();
   const float muMax = levelMuMax(in, s, precision_);
 
@@ -875,7 +737,7 @@ std::vector<IterationStats> ExtinctionOptimizer::runMultigrid(const Optimization
     const size_t levelStart = all.size();
     for (int it = 0; it < s.maxIterationsPerLevel; ++it) {
       const std::optional<IterationStats> done =
-          runIteration(in, s, s.levels, s.maxIterationsPerLevel);
+          runIteration(*level_, in, s, s.maxIterationsPerLevel);
       if (!done) return all;
       all.push_back(*done);
       if (callback && !callback(*done)) return all;
@@ -903,13 +765,16 @@ std::vector<IterationStats> ExtinctionOptimizer::iterate(const OptimizationInput
   std::vector<IterationStats> all;
   for (int it = 0; it < iterations; ++it) {
     std::optional<IterationStats> st =
-        runIteration(in, s, 1, std::max(iterations, s.maxIterationsPerLevel));
+        runIteration(*level_, in, s, std::max(iterations, s.maxIterationsPerLevel));
     if (!st) break;
     st->level = level_->index;
     all.push_back(*st);
     if (callback && !callback(*st)) break;
     if (cutShort_) break;
   }
+  // The finest state moved on: a later follow() restricts it anew rather than correcting it with
+  // a coarse level that describes an older one.
+  if (!all.empty()) follower_.reset();
   return all;
 }
 

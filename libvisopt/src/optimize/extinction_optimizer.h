@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -92,6 +93,21 @@ class ExtinctionOptimizer {
                                       const ExtinctionSettings& settings, int iterations,
                                       const IterationCallback& callback,
                                       const AbandonCheck& abandon = {});
+  // While the camera moves (Himmler & Günther 2026, §III-F: "the visibility optimization adjusts
+  // to new viewpoints during interactive camera navigation"): iterations on the coarsest level of
+  // the multigrid (settings.levels) for the current camera and light, whose change to mu and to
+  // each surface's phi is then prolonged onto the finest level and added there (a coarse-grid
+  // correction; mu clamped to [0, mu_max] as Eq. 14 asks). The coarse level is restricted from
+  // the finest state at the first call after any finest-level change (mu and the surfaces'
+  // deviations as means, mu_bar and g as in the multigrid) and kept, with its own optimiser
+  // state, while only these calls follow each other. A finest level is first built from mu_bar
+  // when there is none. With one level this runs finest-level iterations (iterate()).
+  // `abandon` as for iterate(): an abandoned iteration changes nothing, and what the iterations
+  // before it did is prolonged.
+  std::vector<IterationStats> follow(const OptimizationInputs& in,
+                                     const ExtinctionSettings& settings, int iterations,
+                                     const IterationCallback& callback,
+                                     const AbandonCheck& abandon = {});
   // The optimised extinction on the volume grid, or null before any run.
   const Field3D* extinction() const;
   // The optimised context surfaces phi on the volume grid (one per base), empty before any run.
@@ -102,12 +118,17 @@ class ExtinctionOptimizer {
 
   // Internal steps; public only because nvcc forbids extended device lambdas in private members.
   struct Level;
+  // A level's grid and what does not come from the previous level: on coarse levels mu_bar, g,
+  // each surface's phi0 and the world mask restricted from the finest inputs; ghat and the
+  // level-set scratch when there are surfaces. mu and phi are allocated, not filled. `suffix`
+  // ends the fields' names in the ledger.
+  std::unique_ptr<Level> newLevel(const OptimizationInputs& in, int level, int levels,
+                                  const std::string& suffix = {});
   void buildLevel(const OptimizationInputs& in, const ExtinctionSettings& settings, int level,
                   int levels);
-  // Empty when abandoned (see runMultigrid).
-  std::optional<IterationStats> runIteration(const OptimizationInputs& in,
-                                             const ExtinctionSettings& settings, int levels,
-                                             int cap);
+  // One iteration on `level`; empty when abandoned (see runMultigrid).
+  std::optional<IterationStats> runIteration(Level& level, const OptimizationInputs& in,
+                                             const ExtinctionSettings& settings, int cap);
   // `ghatKept`: ghat already holds what this iteration's inputs give (Level::ghatFor).
   void surfaceStep(const OptimizationInputs& in, Level& level, bool ghatKept,
                    IterationStats& stats);
@@ -118,6 +139,10 @@ class ExtinctionOptimizer {
   MemoryLedger* ledger_;
   Precision precision_;
   std::unique_ptr<Level> level_;
+  // follow(): the coarsest level restricted from level_, and its mu and phi when its change was
+  // last prolonged onto level_.
+  struct Follower;
+  std::unique_ptr<Follower> follower_;
   const AbandonCheck* abandon_ = nullptr;  // during runMultigrid / iterate
   bool cutShort_ = false;                  // the last iteration's level-set steps were cut short
 };

@@ -23,6 +23,12 @@ QImage toQImage(const Image& image) {
 
 // Frames during optimisation: at most this often, so most of the time goes to iterating.
 constexpr int kFrameIntervalMs = 400;
+// While following a drag: coarse iterations per call of Engine::followCamera (each call ends
+// with one prolongation onto the finest grid and is followed by a preview), and calls per camera
+// position. On the default scene a coarse iteration costs ~2 ms against ~50 ms at the finest
+// level (test_camera_follow; the probe reports what a drag costs).
+constexpr int kFollowIterationsPerCall = 4;
+constexpr int kFollowCallsPerCamera = 8;
 // Longest side of the image the optimisation's frustum grids are sized for while following the
 // camera: 128 view rays per side (frustumScale 0.5), about one per voxel column of a 128^3 scene.
 constexpr int kOptimizationSide = 256;
@@ -177,6 +183,11 @@ void EngineController::requestFrame() {
   wake_.notify_all();
 }
 
+void EngineController::setFollowWhileDragging(bool on) {
+  followWhileDragging_ = on;
+  wake_.notify_all();
+}
+
 void EngineController::setOptimizationRunning(bool running) {
   running_ = running;
   converged_ = false;
@@ -201,8 +212,10 @@ bool EngineController::waitIdle(int timeoutMs) {
 bool EngineController::hasWorkLocked() const {
   const bool optimizing =
       running_ && !converged_ && !interacting_ && !clearView_ && snapshot_ && snapshot_->volume;
-  return !tasks_.empty() || cameraDirty_ || frameOwed_ || (previewShown_ && !interacting_) ||
-         optimizing;
+  const bool following = running_ && interacting_ && followWhileDragging_ && followCallsLeft_ > 0 &&
+                         !clearView_ && snapshot_ && snapshot_->volume;
+  return !tasks_.empty() || cameraDirty_ || owedFrameLocked() || (previewShown_ && !interacting_) ||
+         optimizing || following;
 }
 
 void EngineController::runTask(Engine& engine, Task& task) {
@@ -282,6 +295,7 @@ void EngineController::frameDone(const QImage& image, const FrameInfo& info, boo
     previewShown_ = preview;
     // A full frame settles what was owed when it started; a newer request stays owed.
     if (!preview && owedSerial_ == owedAt) frameOwed_ = false;
+    if (preview) previewedSerial_ = owedAt;
   }
   sinceFrame_.restart();
   itersSinceFrame_ = 0;
@@ -339,6 +353,29 @@ void EngineController::optimizeStep(Engine& engine) {
   if (follow_.add(stats.back(), engine.extinctionSettings())) settle();
   std::lock_guard lock(mutex_);
   oweFrameLocked();
+}
+
+bool EngineController::followStep(Engine& engine) {
+  {
+    std::lock_guard lock(mutex_);
+    if (followCallsLeft_ <= 0) return false;
+    --followCallsLeft_;
+  }
+  if (engine.frozen() || !engine.hasImportance()) return false;
+  // Not abandoned by a newer camera: a coarse iteration takes milliseconds, and during a drag a
+  // newer camera is always on its way, so giving way to it would never let one finish. Commands
+  // and pausing still stop it.
+  const auto interrupt = [this] {
+    std::lock_guard lock(mutex_);
+    return quit_ || !tasks_.empty() || !running_ || clearView_.has_value();
+  };
+  const auto stats = engine.followCamera(kFollowIterationsPerCall, {}, interrupt);
+  if (stats.empty()) return false;
+  followIterations_ += int(stats.size());
+  const qulonglong bytes = engine.ledger().totalBytes();
+  const IterationStats last = stats.back();
+  deliver([this, last, bytes] { emit iterationDone(last, bytes); });
+  return true;
 }
 
 void EngineController::workerLoop() {
@@ -400,14 +437,36 @@ void EngineController::workerLoop() {
     }
     if (cameraChanged && interacting) {
       renderFrame(engine, true);  // the preview first: it is what the user waits for
+      std::lock_guard lock(mutex_);
+      followCallsLeft_ = kFollowCallsPerCamera;
       continue;
     }
     if (cameraChanged) {
       renderFrame(engine, false);
       continue;
     }
-    // While the user drags, only previews: an iteration in flight is all the camera waits for.
-    // ClearView's frames do not show the optimisation: it waits while they are on.
+    // While the user drags, the optimisation follows on the coarsest level between previews,
+    // each call followed by a preview that shows what it opened; a finest iteration would make
+    // the camera wait for it. ClearView's frames do not show the optimisation: it waits while
+    // they are on.
+    if (running_ && interacting && followWhileDragging_ && !clearViewOn) {
+      bool followed = false;
+      try {
+        followed = followStep(engine);
+      } catch (const std::exception& e) {
+        running_ = false;
+        const QString msg = QStringLiteral("optimisation: ") + QString::fromUtf8(e.what());
+        deliver([this, msg] { emit errorOccurred(msg); });
+      }
+      if (followed) {
+        {
+          std::lock_guard lock(mutex_);
+          if (cameraDirty_ || !tasks_.empty()) continue;  // the newer camera's preview shows it
+        }
+        renderFrame(engine, true);
+        continue;
+      }
+    }
     const bool optimizing =
         running_ && !converged_ && !interacting && !clearViewOn && engine.hasImportance();
     if (optimizing) {
@@ -432,7 +491,7 @@ void EngineController::workerLoop() {
     bool owed, previewShown;
     {
       std::lock_guard lock(mutex_);
-      owed = frameOwed_;
+      owed = owedFrameLocked();
       previewShown = previewShown_;
     }
     if (owed || (previewShown && !interacting)) renderFrame(engine, interacting);

@@ -103,6 +103,12 @@ class EngineController : public QObject {
   // Waits until the worker has nothing left to do right now: no command queued, no frame owed
   // (tests and --screenshot). Returns false on timeout.
   bool waitIdle(int timeoutMs);
+  // While the user drags, the optimisation follows on the coarsest multigrid level between
+  // previews (Engine::followCamera; on by default), so that the openings move with the camera.
+  void setFollowWhileDragging(bool on);
+  bool followWhileDragging() const { return followWhileDragging_; }
+  // Coarse iterations run while following since the controller started (tests, the probe).
+  int followIterations() const { return followIterations_; }
   // True once an optimisation has converged at the finest level since the last restart.
   bool converged() const { return converged_; }
 
@@ -129,6 +135,8 @@ class EngineController : public QObject {
   bool hasWorkLocked() const;
   void runTask(Engine& engine, Task& task);
   void optimizeStep(Engine& engine);
+  // One call of Engine::followCamera while the user drags; false when it did nothing.
+  bool followStep(Engine& engine);
   void renderFrame(Engine& engine, bool preview);
   // ClearView's frame when it is on: true when the frame is done (rendered, or refused before for
   // the same settings and nothing changed since); false: render the normal frame.
@@ -159,6 +167,12 @@ class EngineController : public QObject {
     frameOwed_ = true;
     ++owedSerial_;
   }
+  // While the user holds the camera, what is owed is shown by one preview, not by a preview
+  // after every other: the full frame waits for the release.
+  uint64_t previewedSerial_ = 0;
+  bool owedFrameLocked() const {
+    return frameOwed_ && !(interacting_ && previewedSerial_ == owedSerial_);
+  }
   bool previewShown_ = false;  // the last frame was a preview
   RenderSettings render_;
   int viewportWidth_ = 512, viewportHeight_ = 512;
@@ -166,6 +180,12 @@ class EngineController : public QObject {
   std::atomic<bool> running_{false};
   std::atomic<bool> cancel_{false};
   std::atomic<bool> converged_{false};
+  std::atomic<bool> followWhileDragging_{true};
+  std::atomic<int> followIterations_{0};
+  // Calls of Engine::followCamera still to run for the current drag position (under mutex_):
+  // renewed at every camera change of a drag, so that a pause in the drag converges on the
+  // coarse level and then rests.
+  int followCallsLeft_ = 0;
   bool restartPending_ = true;  // next optimisation step runs the multigrid schedule
   int itersSinceFrame_ = 0;
   // Worker-only: convergence while following the camera.

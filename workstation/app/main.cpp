@@ -64,6 +64,7 @@ int runLatencyProbe(MainWindow& window, int steps, const QString& framesDir) {
           view->frame().save(framesDir + QStringLiteral("/drag-preview-%1.png").arg(previews));
         ++previews;
       });
+  const int followedBefore = window.controller()->followIterations();
   QElapsedTimer drag;
   drag.start();
   while (drag.elapsed() < 3000) {
@@ -72,6 +73,7 @@ int runLatencyProbe(MainWindow& window, int steps, const QString& framesDir) {
   }
   const double previewsPerSecond = double(previews) * 1000.0 / double(drag.elapsed());
   QObject::disconnect(counting);
+  const int followedDuringDrag = window.controller()->followIterations() - followedBefore;
   // The release: the time until the optimisation has converged for the resting view and a full
   // frame shows it.
   view->setCamera(view->camera(), false);
@@ -86,17 +88,31 @@ int runLatencyProbe(MainWindow& window, int steps, const QString& framesDir) {
             view->frame().save(framesDir + QStringLiteral("/rest-full.png"));
         }
       });
+  // What the resting view shows of the important structures: V_occ (visibility through
+  // occluders) as the first finest iteration after the release measures it, before its own step
+  // (the state the drag left), and as the last one before convergence.
+  double restVisibility = -1.0, convergedVisibility = -1.0;
+  const QMetaObject::Connection visibility =
+      QObject::connect(window.controller(), &EngineController::iterationDone,
+                       [&](const IterationStats& st, qulonglong) {
+                         if (st.level == 0 && window.controller()->followWhileDragging()) return;
+                         if (restVisibility < 0.0) restVisibility = st.visibilityViewOccluders;
+                         convergedVisibility = st.visibilityViewOccluders;
+                       });
   const bool settled = window.waitForSettledFrame(300000);
   QObject::disconnect(full);
+  QObject::disconnect(visibility);
   const double restToConvergedMs = settled ? double(rest.elapsed()) : -1.0;
 
   std::printf(
       "{\"latencyProbe\": {\"drags\": %d, \"framesMatched\": %d, \"meanMs\": %.1f, "
       "\"p95Ms\": %.1f, \"maxMs\": %.1f, \"previewRenderMeanMs\": %.1f, "
       "\"previewsPerSecondDuringDrag\": %.1f, \"restToFullFrameMs\": %.0f, "
-      "\"restToConvergedMs\": %.0f}}\n",
+      "\"restToConvergedMs\": %.0f, \"followIterationsDuringDrag\": %d, "
+      "\"restVisibilityThroughOccluders\": %.3f, \"convergedVisibilityThroughOccluders\": %.3f}}\n",
       steps, s.samples, s.meanMs, s.p95Ms, s.maxMs, s.renderMeanMs, previewsPerSecond,
-      restToFullFrameMs, restToConvergedMs);
+      restToFullFrameMs, restToConvergedMs, followedDuringDrag, restVisibility,
+      convergedVisibility);
   return s.samples > 0 && settled ? 0 : 1;
 }
 
@@ -141,6 +157,9 @@ int main(int argc, char** argv) {
                                  QStringLiteral("With --latency-probe: save frames of the drag and "
                                                 "of the resting view in DIR."),
                                  QStringLiteral("DIR"));
+  QCommandLineOption noFollow(QStringLiteral("no-drag-following"),
+                              QStringLiteral("Do not optimise on the coarsest level while the "
+                                             "camera is dragged (default: follow)."));
   QCommandLineOption stateDir(QStringLiteral("state-dir"),
                               QStringLiteral("Folder for autosave and recent sessions."),
                               QStringLiteral("DIR"));
@@ -161,7 +180,8 @@ int main(int argc, char** argv) {
                                          "Navigate, Paint mask, Lens, Window mask, Hotspot)."),
                           QStringLiteral("NAME"));
   parser.addOptions({scene, volume, session, resolution, screenshot, windowShot, size, noOptimize,
-                     latency, probeFrames, stateDir, timeout, saveTo, deviation, tab, tool});
+                     latency, probeFrames, noFollow, stateDir, timeout, saveTo, deviation, tab,
+                     tool});
   parser.addPositionalArgument(
       QStringLiteral("files"),
       QStringLiteral("A volume file or DICOM folder, or a session (.visopt-session, .json), to "
@@ -189,6 +209,7 @@ int main(int argc, char** argv) {
   }
   window.show();
   window.setOptimizationRunning(!parser.isSet(noOptimize));
+  window.controller()->setFollowWhileDragging(!parser.isSet(noFollow));
 
   int failures = 0;
   QObject::connect(&window, &MainWindow::errorShown, [&](const QString& message) {

@@ -453,6 +453,13 @@ void MainWindow::buildMenus() {
   opt->addAction(actRun_);
   opt->addAction(actFreeze_);
   opt->addAction(actLookElsewhere_);
+  QAction* follow = opt->addAction(tr("Follow the camera while dragging"));
+  follow->setCheckable(true);
+  follow->setChecked(controller_->followWhileDragging());
+  follow->setToolTip(
+      tr("While the camera is dragged, optimise on the coarsest grid between previews so the "
+         "openings move with it (on by default); off: only previews until the camera rests"));
+  connect(follow, &QAction::toggled, controller_.get(), &EngineController::setFollowWhileDragging);
   opt->addAction(tr("Restart from the transfer function"), this,
                  [this] { controller_->restartOptimization(); });
   opt->addSeparator();

@@ -79,6 +79,26 @@ class DragFollowingTest : public QObject {
     QVERIFY2(v > 0.3, qPrintable(QStringLiteral("V_occ %1").arg(v)));
   }
 
+  // A mouse in motion: a newer camera arrives before each preview is done, and following still
+  // runs (one call per preview), or it would wait for the mouse to stop.
+  void followingRunsDuringAContinuousDrag() {
+    EngineController c(Precision::FP32);
+    const Camera start = convergedScene(c);
+    QVERIFY(c.converged());
+    QElapsedTimer drag;
+    drag.start();
+    float degrees = 0.f;
+    while (drag.elapsed() < 1500) {
+      degrees += 0.5f;
+      c.setCamera(turned(start, degrees), true);
+      pumpUntil([] { return false; }, 16);
+    }
+    QVERIFY2(c.followIterations() > 0,
+             qPrintable(QStringLiteral("follow iterations %1").arg(c.followIterations())));
+    c.setCamera(turned(start, degrees), false);
+    QVERIFY(c.waitIdle(240000));
+  }
+
   void withFollowingOffADragOnlyPreviews() {
     EngineController c(Precision::FP32);
     c.setFollowWhileDragging(false);

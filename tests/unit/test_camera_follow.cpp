@@ -177,7 +177,10 @@ TEST(CameraFollow, CoarseIterationsOpenTheSurfaceForTheNewView) {
   }
   const auto stats = following.followCamera(20);
   ASSERT_EQ(stats.size(), 20u);
-  for (const IterationStats& st : stats) EXPECT_EQ(st.level, 0) << "the coarsest level";
+  for (const IterationStats& st : stats) {
+    EXPECT_EQ(st.level, 0) << "the coarsest level";
+    EXPECT_TRUE(st.following);
+  }
   EXPECT_LT(stats.front().visibilityView, 0.1) << "the back cap hides the disc at first";
 
   const double followed = visibilityNow(following), stayed = visibilityNow(waiting);
@@ -285,4 +288,38 @@ TEST(CameraFollow, TheDefaultSceneOpensForATurnedCamera) {
   ASSERT_EQ(stayed.size(), 1u);
   EXPECT_LT(stayed[0].visibilityViewOccluders, 0.1);
   EXPECT_GT(followed[0].visibilityViewOccluders, 0.3);
+}
+
+// A preview while dragging draws the extinction as the coarse correction left it (otherwise it
+// would show the last full frame's mu until the release), with the T_L it has; the next full
+// frame computes T_L again. A scene of volume occluders only, so that nothing else (a context
+// surface, drawn live) could make the previews differ.
+TEST(CameraFollow, APreviewAfterFollowingDrawsTheCorrectedExtinction) {
+  Engine e;
+  loadOccluderScene(e);
+  ExtinctionSettings st;
+  st.levels = 2;
+  st.maxIterationsPerLevel = 30;
+  e.setExtinctionSettings(st);
+  e.optimize();
+  RenderSettings full;
+  full.width = full.height = 64;
+  (void)e.render(full);
+  e.setCamera(Camera::orbit({0, 0, 0}, 90.f, 0.f, 90.f));
+  RenderSettings preview = full;
+  preview.preview = true;
+  const Image before = e.render(preview);
+  ASSERT_EQ(e.followCamera(10).size(), 10u);
+  RenderStats stats;
+  const Image after = e.render(preview, &stats);
+  EXPECT_EQ(stats.lightMilliseconds, 0.0) << "the preview keeps the T_L it has";
+  ASSERT_EQ(before.pixels.size(), after.pixels.size());
+  double changed = 0.0;
+  for (size_t i = 0; i < before.pixels.size(); ++i)
+    changed += double(glm::length(before.pixels[i] - after.pixels[i]));
+  EXPECT_GT(changed, 0.0) << "the preview must draw the corrected mu, not the last full frame's";
+  const Image again = e.render(preview, &stats);
+  EXPECT_EQ(again.pixels, after.pixels) << "nothing changed since: the same preview";
+  (void)e.render(full, &stats);
+  EXPECT_GT(stats.lightMilliseconds, 0.0) << "the full frame after following computes T_L again";
 }

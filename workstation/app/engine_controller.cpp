@@ -378,6 +378,17 @@ bool EngineController::followStep(Engine& engine) {
   return true;
 }
 
+bool EngineController::followOnce(Engine& engine) {
+  try {
+    return followStep(engine);
+  } catch (const std::exception& e) {
+    running_ = false;
+    const QString msg = QStringLiteral("optimisation: ") + QString::fromUtf8(e.what());
+    deliver([this, msg] { emit errorOccurred(msg); });
+    return false;
+  }
+}
+
 void EngineController::workerLoop() {
   Engine engine(precision_);
   for (;;) {
@@ -437,8 +448,14 @@ void EngineController::workerLoop() {
     }
     if (cameraChanged && interacting) {
       renderFrame(engine, true);  // the preview first: it is what the user waits for
-      std::lock_guard lock(mutex_);
-      followCallsLeft_ = kFollowCallsPerCamera;
+      {
+        std::lock_guard lock(mutex_);
+        followCallsLeft_ = kFollowCallsPerCamera;
+      }
+      // A mouse in motion sends a newer camera before each preview is done: one call of
+      // following per preview even then (a few ms; the next preview shows what it opened), or a
+      // continuous drag would never follow.
+      if (running_ && followWhileDragging_ && !clearViewOn) followOnce(engine);
       continue;
     }
     if (cameraChanged) {
@@ -450,15 +467,7 @@ void EngineController::workerLoop() {
     // the camera wait for it. ClearView's frames do not show the optimisation: it waits while
     // they are on.
     if (running_ && interacting && followWhileDragging_ && !clearViewOn) {
-      bool followed = false;
-      try {
-        followed = followStep(engine);
-      } catch (const std::exception& e) {
-        running_ = false;
-        const QString msg = QStringLiteral("optimisation: ") + QString::fromUtf8(e.what());
-        deliver([this, msg] { emit errorOccurred(msg); });
-      }
-      if (followed) {
+      if (followOnce(engine)) {
         {
           std::lock_guard lock(mutex_);
           if (cameraDirty_ || !tasks_.empty()) continue;  // the newer camera's preview shows it

@@ -137,6 +137,7 @@ class EngineController : public QObject {
   void optimizeStep(Engine& engine);
   // One call of Engine::followCamera while the user drags; false when it did nothing.
   bool followStep(Engine& engine);
+  bool followOnce(Engine& engine);  // followStep; an error stops the optimisation and is shown
   void renderFrame(Engine& engine, bool preview);
   // ClearView's frame when it is on: true when the frame is done (rendered, or refused before for
   // the same settings and nothing changed since); false: render the normal frame.

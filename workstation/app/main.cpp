@@ -95,7 +95,7 @@ int runLatencyProbe(MainWindow& window, int steps, const QString& framesDir) {
   const QMetaObject::Connection visibility =
       QObject::connect(window.controller(), &EngineController::iterationDone,
                        [&](const IterationStats& st, qulonglong) {
-                         if (st.level == 0 && window.controller()->followWhileDragging()) return;
+                         if (st.following) return;  // a coarse iteration, not the resting view's
                          if (restVisibility < 0.0) restVisibility = st.visibilityViewOccluders;
                          convergedVisibility = st.visibilityViewOccluders;
                        });

@@ -51,6 +51,7 @@ struct ImportanceLens {
 
 struct IterationStats {
   int level = 0, iteration = 0;
+  bool following = false;  // a coarse iteration of Engine::followCamera, not of the finest level
   double energyRho = 0.0, energyQ = 0.0, energyR = 0.0;
   double energy() const { return energyRho + energyQ + energyR; }
   double visibilityView = 0.0;   // V = ∫ g mu T_V / ∫ g mu over the view frustum

@@ -41,6 +41,9 @@ struct Engine::Impl {
   // The optimisation changed mu since T_L and the extinction change were computed: a full frame
   // recomputes both, a preview reuses them (render()).
   bool muChanged = false;
+  // followCamera corrected mu since the extinction change was drawn: a preview draws the change
+  // again (a pass over the volume) but keeps T_L, so what the drag opened shows while dragging.
+  bool followedSinceChange = false;
   // T_L holds the light's transmittance through an earlier mu (or, after a full frame that gave
   // way to a newer camera, partly through it): a full frame recomputes it, a preview may use it
   // (lightDirty, by contrast, means the light, the transfer function or the scene changed).
@@ -351,7 +354,11 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
                      (!optimized || !impl_->renderOptimized || impl_->extinctionChange);
   if (!reuse) {
     if (impl_->muChanged) impl_->lightFromOlderMu = true;
-    impl_->muChanged = false;
+    impl_->muChanged = impl_->followedSinceChange = false;
+    impl_->updateExtinctionChange(optimized);
+  } else if (impl_->followedSinceChange && optimized) {
+    impl_->lightFromOlderMu = true;  // muChanged stays: the next full frame computes T_L again
+    impl_->followedSinceChange = false;
     impl_->updateExtinctionChange(optimized);
   }
   // A full frame's T_L gives way to a newer camera too: the preview that answers it draws with
@@ -701,7 +708,7 @@ std::vector<IterationStats> Engine::followCamera(
   auto stats = impl_->optimizer.follow(impl_->optimizationInputs(), impl_->extinctionSettings,
                                        iterations, callback, abandon);
   if (!stats.empty()) {  // the finest mu and surfaces changed by the correction
-    impl_->muChanged = true;
+    impl_->muChanged = impl_->followedSinceChange = true;
     ++impl_->sceneRevision;
   }
   return stats;

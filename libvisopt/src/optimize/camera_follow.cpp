@@ -95,6 +95,7 @@ std::vector<IterationStats> ExtinctionOptimizer::follow(const OptimizationInputs
     std::optional<IterationStats> st =
         runIteration(coarse, in, s, std::max(iterations, s.maxIterationsPerLevel));
     if (!st) break;
+    st->following = true;
     all.push_back(*st);
     if (callback && !callback(*st)) break;
     if (cutShort_) break;

@@ -63,6 +63,18 @@ inline std::vector<glm::dvec2> blobImportance() {
   return {{0.0, 0.0}, {0.4, 0.0}, {0.45, 1.0}, {0.55, 1.0}, {0.6, 0.0}, {1.0, 0.0}};
 }
 
+// A thin-shell sphere's SDF (Eq. 26) on a grid: |(|x| - radius)| - shell.
+inline Field3D shellSphereSdf(const GridSpec& g, float radius, float shell) {
+  Field3D phi("sphere", g, Precision::FP32);
+  for (int k = 0; k < g.dims.z; ++k)
+    for (int j = 0; j < g.dims.y; ++j)
+      for (int i = 0; i < g.dims.x; ++i) {
+        const glm::vec3 x = g.indexToWorld(glm::vec3(float(i), float(j), float(k)));
+        phi.set(g.linearIndex(i, j, k), std::abs(glm::length(x) - radius) - shell);
+      }
+  return phi;
+}
+
 inline void loadOccluderScene(Engine& engine, const OccluderScene& s = {}) {
   engine.setVolume(makeOccluderVolume(s, engine.precision()));
   engine.setTransferFunction(occluderTransferFunction());

@@ -128,13 +128,7 @@ void setup(Engine& e) {
   e.setLight(light);
   e.setViewportSize(48, 48);
   const GridSpec& g = e.volume().grid();
-  Field3D phi0("sphere", g, Precision::FP32);
-  for (int k = 0; k < g.dims.z; ++k)
-    for (int j = 0; j < g.dims.y; ++j)
-      for (int i = 0; i < g.dims.x; ++i) {
-        const glm::vec3 x = g.indexToWorld(glm::vec3(float(i), float(j), float(k)));
-        phi0.set(g.linearIndex(i, j, k), std::abs(glm::length(x) - kSphereRadius) - kShell);
-      }
+  const Field3D phi0 = shellSphereSdf(g, kSphereRadius, kShell);
   ContextSurfaceSpec spec;
   spec.source = "test:shell sphere";
   spec.filled = false;

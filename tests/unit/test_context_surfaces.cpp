@@ -50,14 +50,7 @@ Volume blobVolume(Precision p) {
 
 // Thin-shell sphere SDF (Eq. 26) on the volume grid.
 Field3D shellSphere(const GridSpec& g) {
-  Field3D phi("sphere", g, Precision::FP32);
-  for (int k = 0; k < g.dims.z; ++k)
-    for (int j = 0; j < g.dims.y; ++j)
-      for (int i = 0; i < g.dims.x; ++i) {
-        const glm::vec3 x = g.indexToWorld(glm::vec3(float(i), float(j), float(k)));
-        phi.set(g.linearIndex(i, j, k), std::abs(glm::length(x) - kSphereRadius) - kShell);
-      }
-  return phi;
+  return shellSphereSdf(g, kSphereRadius, kShell);
 }
 
 void setup(Engine& e) {

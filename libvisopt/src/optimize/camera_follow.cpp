@@ -7,8 +7,6 @@
 #include <algorithm>
 #include <limits>
 
-#include "core/field_view.h"
-#include "exec/parallel.h"
 #include "optimize/extinction_optimizer.h"
 #include "optimize/level_set.h"
 #include "optimize/multigrid_transfer.h"
@@ -16,16 +14,6 @@
 #include "visopt/error.h"
 
 namespace visopt {
-
-namespace {
-
-void copyValues(const Field3D& src, Field3D& dst) {
-  const FieldView from(src), to(dst);
-  exec::parallelFor("follow: keep coarse state", int64_t(src.size()),
-                    [=] VISOPT_HD(int64_t v) { to.store(size_t(v), from.load(size_t(v))); });
-}
-
-}  // namespace
 
 std::vector<IterationStats> ExtinctionOptimizer::follow(const OptimizationInputs& in,
                                                         const ExtinctionSettings& s, int iterations,
@@ -73,10 +61,10 @@ std::vector<IterationStats> ExtinctionOptimizer::follow(const OptimizationInputs
       redistance(c.phi[si], in.levelSet, *c.scratch);
     }
     f->muBefore.emplace("extinction (following, prolonged)", c.grid, precision_, ledger_);
-    copyValues(*c.mu, *f->muBefore);
+    copyField(*c.mu, *f->muBefore);
     for (size_t si = 0; si < c.phi.size(); ++si) {
       f->phiBefore.emplace_back("surface (following, prolonged)", c.grid, precision_, ledger_);
-      copyValues(c.phi[si], f->phiBefore.back());
+      copyField(c.phi[si], f->phiBefore.back());
     }
     f->fineDims = fine.grid.dims;
     f->levels = levels;
@@ -105,12 +93,12 @@ std::vector<IterationStats> ExtinctionOptimizer::follow(const OptimizationInputs
   // The correction: the finest level gains what the coarse iterations changed.
   const GridMap coarseMap(coarse.grid);
   prolongChange(*coarse.mu, *f.muBefore, coarseMap, *fine.mu, 0.f, levelMuMax(in, s, precision_));
-  copyValues(*coarse.mu, *f.muBefore);
+  copyField(*coarse.mu, *f.muBefore);
   const float big = std::numeric_limits<float>::max();
   for (size_t si = 0; si < coarse.phi.size(); ++si) {
     const double moved =
         prolongChange(coarse.phi[si], f.phiBefore[si], coarseMap, fine.phi[si], -big, big);
-    copyValues(coarse.phi[si], f.phiBefore[si]);
+    copyField(coarse.phi[si], f.phiBefore[si]);
     if (moved > 0.0) {
       // phi changed outside the kernels that keep the band: find it again from phi at the next
       // finest step, and redistance there (the prolonged change is no distance function).

@@ -144,12 +144,6 @@ void ensureLike(Field3D& scratch, const Field3D& phi) {
     scratch = Field3D("level-set-scratch", phi.grid(), phi.precision(), nullptr);
 }
 
-void copyField(const Field3D& from, Field3D& to) {
-  const FieldView a(from), b(to);
-  exec::parallelFor("level set: copy", int64_t(from.size()),
-                    [=] VISOPT_HD(int64_t v) { b.store(size_t(v), a.load(size_t(v))); });
-}
-
 // The result of a ping-pong loop back into phi: over the band only when there is one (nothing
 // else was written).
 void copyResult(const Field3D& from, Field3D& phi, const Band* band) {
@@ -271,6 +265,12 @@ double redistancePass(const Field3D& in, Field3D& out, bool initialise, int orde
 }
 
 }  // namespace
+
+void copyField(const Field3D& from, Field3D& to) {
+  const FieldView a(from), b(to);
+  exec::parallelFor("level set: copy", int64_t(from.size()),
+                    [=] VISOPT_HD(int64_t v) { b.store(size_t(v), a.load(size_t(v))); });
+}
 
 // ---- the level-set step (Eq. 23) ------------------------------------------------------------
 

@@ -30,6 +30,9 @@ LevelSetStepStats levelSetStep(Field3D& phi, const Field3D& phi0, const Field3D&
                                const DeviceBitMask* mask, const LevelSetSettings& s,
                                Field3D& scratch, NarrowBand* band = nullptr);
 
+// Every value of `from` into `to` (the same grid; either precision), in parallel.
+void copyField(const Field3D& from, Field3D& to);
+
 // The stable dt levelSetStep would use (the same formula), for tests and callers.
 double levelSetTimeStep(const Field3D& ghat, const LevelSetSettings& s);
 

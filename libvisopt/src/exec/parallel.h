@@ -121,8 +121,12 @@ T reduce(const char* name, int64_t n, T init, F f, Op op) {
     return acc;
   }
 #endif
-  return tbb::parallel_reduce(
-      tbb::blocked_range<int64_t>(0, n), init,
+  // Deterministic: the ranges and the order they are combined in depend on n only (at most 512
+  // leaves), not on how the threads stole work, so a floating-point sum is the same in every
+  // run (the auto-partitioned reduce differed in its last bits under load).
+  const int64_t grain = (n + 255) / 256;
+  return tbb::parallel_deterministic_reduce(
+      tbb::blocked_range<int64_t>(0, n, size_t(grain)), init,
       [&](const tbb::blocked_range<int64_t>& r, T acc) {
         for (int64_t i = r.begin(); i != r.end(); ++i) acc = op(acc, f(i));
         return acc;

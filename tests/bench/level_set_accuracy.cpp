@@ -6,8 +6,8 @@
 //
 // Surface deviation: |phi - phi_ref| in voxels over the voxels within 1.5 voxels of either zero
 // level set (|phi| < 1.5 h or |phi_ref| < 1.5 h), mean and max. Image error: PSNR (visopt::psnr,
-// sRGB) and SSIM (image_metrics.h, sRGB luma). Every image is rendered with the same settings
-// and jitter seed, so images differ only through mu and phi.
+// sRGB) and SSIM (visopt/image_metrics.h, sRGB luma). Every image is rendered with the same
+// settings and jitter seed, so images differ only through mu and phi.
 //
 // The reference: fp32, 3 levels, redistancing until the mean squared change per iteration falls
 // below 1e-7 voxel^2 (at most 256 iterations), and a larger iteration budget with a small energy
@@ -29,9 +29,9 @@
 #include <string>
 #include <vector>
 
-#include "image_metrics.h"
 #include "visopt/engine.h"
 #include "visopt/exec.h"
+#include "visopt/image_metrics.h"
 
 namespace {
 
@@ -168,7 +168,7 @@ int run(const Setup& setup) {
       double(refLs.redistanceTolerance), ref.stats.size(), ref.seconds, redistanceSeconds(ref),
       meanRedistanceIterations(ref), ref.stats.back().visibilityView,
       ref.stats.back().maxDeviationVoxels, moved.mean, moved.max, moved.voxels,
-      visopt::psnr(before, ref.image), visopt::bench::ssim(before, ref.image));
+      visopt::psnr(before, ref.image), visopt::ssim(before, ref.image));
   std::fflush(stdout);
 
   std::printf(
@@ -191,7 +191,7 @@ int run(const Setup& setup) {
     std::printf("| %s | %s | %d | %zu | %.1f | %.2f | %.2f | %.3f | %.2f | %.2f | %.4f | %.3f |\n",
                 capText.c_str(), visopt::toString(p), levels, r.stats.size(),
                 meanRedistanceIterations(r), r.seconds, redistanceSeconds(r), d.mean, d.max,
-                visopt::psnr(r.image, ref.image), visopt::bench::ssim(r.image, ref.image),
+                visopt::psnr(r.image, ref.image), visopt::ssim(r.image, ref.image),
                 r.stats.empty() ? 0.0 : r.stats.back().visibilityView);
     if (d.max > 3.0) {
       const glm::ivec3 dims = engine.volume().grid().dims;

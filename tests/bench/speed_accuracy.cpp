@@ -2,8 +2,9 @@
 // storage precision, number of multigrid levels, view frustum scale and per-level iteration budget,
 // the wall time of Engine::optimize() and the error of the rendered image against a converged
 // reference (fp32, 3 levels, frustum scale 1, a large budget and a small tolerance): PSNR
-// (visopt::psnr, sRGB), SSIM (image_metrics.h, sRGB luma) and the relative RMS difference of the
-// optimised extinction from the reference's. Every image is rendered with the same settings and
+// (visopt::psnr, sRGB), SSIM (visopt/image_metrics.h, sRGB luma), the mean LDR-FLIP (the paper's
+// metric, visopt::flip at its default observer) and the relative RMS difference of
+// the optimised extinction from the reference's. Every image is rendered with the same settings and
 // jitter seed, so the images differ only through mu. Prints the results as Markdown.
 //
 // Budget runs keep the library's default tolerance, so a level may end before its budget; the
@@ -23,9 +24,9 @@
 
 #include <time.h>
 
-#include "image_metrics.h"
 #include "visopt/engine.h"
 #include "visopt/exec.h"
+#include "visopt/image_metrics.h"
 
 namespace {
 
@@ -130,15 +131,16 @@ int run(const Setup& setup) {
   std::printf(
       "Reference: fp32, 3 levels, frustum scale 1, at most %d iterations per level, tolerance "
       "%g: %zu iterations in %.1f s (CPU share %.2f); %s.\nThe unoptimised image (mu_bar) "
-      "against it: PSNR %.2f dB, SSIM %.4f.\n\n",
+      "against it: PSNR %.2f dB, SSIM %.4f, FLIP %.4f.\n\n",
       ref.maxIterationsPerLevel, static_cast<double>(ref.tolerance), refRun.stats.size(),
       refRun.seconds, refRun.cpuShare, convergence(refRun).c_str(),
-      visopt::psnr(unoptimized, refRun.image), visopt::bench::ssim(unoptimized, refRun.image));
+      visopt::psnr(unoptimized, refRun.image), visopt::ssim(unoptimized, refRun.image),
+      visopt::flip(refRun.image, unoptimized).mean);
   std::fflush(stdout);
 
   std::printf(
       "| precision | levels | frustum scale | budget / level | iterations | time (s) | CPU share "
-      "| PSNR (dB) | SSIM | mu rel. RMS |\n|---|---|---|---|---|---|---|---|---|---|\n");
+      "| PSNR (dB) | SSIM | FLIP | mu rel. RMS |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (Precision p : {Precision::FP32, Precision::FP16}) {
     visopt::Engine engine(p);
     engine.loadBuiltinScene(setup.scene, setup.volume);
@@ -151,11 +153,11 @@ int run(const Setup& setup) {
           s.frustumScale = scale;
           s.maxIterationsPerLevel = budget;
           const Run r = optimizeAndRender(engine, s, setup);
-          std::printf("| %s | %d | %.2f | %d | %d | %.2f | %.2f | %.2f | %.4f | %.4f |\n",
+          std::printf("| %s | %d | %.2f | %d | %d | %.2f | %.2f | %.2f | %.4f | %.4f | %.4f |\n",
                       visopt::toString(p), levels, static_cast<double>(scale), budget,
                       static_cast<int>(r.stats.size()), r.seconds, r.cpuShare,
-                      visopt::psnr(r.image, refRun.image),
-                      visopt::bench::ssim(r.image, refRun.image), relativeRms(r.mu, refRun.mu));
+                      visopt::psnr(r.image, refRun.image), visopt::ssim(r.image, refRun.image),
+                      visopt::flip(refRun.image, r.image).mean, relativeRms(r.mu, refRun.mu));
           std::fflush(stdout);
         }
   }

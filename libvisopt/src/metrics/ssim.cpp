@@ -1,12 +1,13 @@
-#include "image_metrics.h"
+// SSIM on sRGB luma (visopt/image_metrics.h): separable Gaussian window over the valid positions.
+#include "visopt/error.h"
+#include "visopt/image_metrics.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <stdexcept>
 
-namespace visopt::bench {
+namespace visopt {
 
 namespace {
 
@@ -14,7 +15,7 @@ constexpr int kRadius = 5;  // 11x11 window
 constexpr double kSigma = 1.5;
 
 float encodeSrgb(float linear) {
-  const float c = std::clamp(linear, 0.f, 1.f);
+  const float c = linear > 0.f ? std::min(linear, 1.f) : 0.f;  // NaN -> 0, as writePng
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
 }
 
@@ -53,8 +54,8 @@ std::vector<double> filterValid(const std::vector<double>& in, int width, int he
   return out;
 }
 
-}  // namespace
-
+// Luma of the sRGB-encoded image (Rec. 709 weights on the encoded channels, each clamped to
+// [0, 1] first), row-major: the values a display shows, as PSNR uses them.
 std::vector<float> srgbLuma(const Image& image) {
   std::vector<float> y(image.pixels.size());
   for (size_t i = 0; i < y.size(); ++i) {
@@ -64,11 +65,17 @@ std::vector<float> srgbLuma(const Image& image) {
   return y;
 }
 
+}  // namespace
+
+bool ssimApplies(const Image& a) {
+  return a.width > 2 * kRadius && a.height > 2 * kRadius;
+}
+
 double ssim(const Image& a, const Image& b) {
-  if (a.width != b.width || a.height != b.height)
-    throw std::invalid_argument("ssim: the images differ in size");
-  if (a.width <= 2 * kRadius || a.height <= 2 * kRadius)
-    throw std::invalid_argument("ssim: the images are smaller than the 11x11 window");
+  if (a.width != b.width || a.height != b.height || a.pixels.size() != b.pixels.size())
+    throw Error(ErrorKind::Usage, "ssim: the images differ in size");
+  if (!ssimApplies(a))
+    throw Error(ErrorKind::Usage, "ssim: the images are smaller than the 11x11 window");
   const std::vector<float> la = srgbLuma(a), lb = srgbLuma(b);
   const size_t n = la.size();
   std::vector<double> x(n), y(n), xx(n), yy(n), xy(n);
@@ -94,4 +101,4 @@ double ssim(const Image& a, const Image& b) {
   return sum / static_cast<double>(mx.size());
 }
 
-}  // namespace visopt::bench
+}  // namespace visopt

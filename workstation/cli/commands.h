@@ -17,5 +17,6 @@ Runner addOptimizeCommand(CLI::App& app);
 Runner addCompareCommand(CLI::App& app);
 Runner addSdfCommand(CLI::App& app);
 Runner addSessionInfoCommand(CLI::App& app);
+Runner addImageDiffCommand(CLI::App& app);
 
 }  // namespace visopt::cli

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   add(addCompareCommand, "compare", "The four methods of Fig. 10 side by side");
   add(addSdfCommand, "sdf", "Convert a triangle mesh to a signed distance field (.vdb)");
   add(addSessionInfoCommand, "session-info", "Describe a session file and check its data files");
+  add(addImageDiffCommand, "image-diff", "PSNR, SSIM and FLIP of two images of the same size");
 
   try {
     app.parse(argc, argv);

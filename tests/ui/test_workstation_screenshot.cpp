@@ -76,6 +76,7 @@ class TestWorkstationScreenshot : public QObject {
 
  private slots:
   void windowScreenshotUnderXvfb();
+  void sessionOptionOpensTheSession();
 };
 
 void TestWorkstationScreenshot::windowScreenshotUnderXvfb() {
@@ -158,6 +159,54 @@ void TestWorkstationScreenshot::windowScreenshotUnderXvfb() {
                           .arg(at.y())
                           .arg(viewport.width())
                           .arg(viewport.height())));
+}
+
+// `--session FILE` opens the session (QGuiApplication takes "-session" for X11 session
+// management out of argv, so the option used to open the default scene instead): what
+// --save-session writes is the session's scene and hotspot settings.
+void TestWorkstationScreenshot::sessionOptionOpensTheSession() {
+  const QString dir = QStringLiteral(VISOPT_TEST_TMP) + QStringLiteral("/workstation-session");
+  QDir(dir).removeRecursively();
+  QVERIFY(QDir().mkpath(dir));
+  const QString in = dir + QStringLiteral("/in.visopt-session");
+  const QString out = dir + QStringLiteral("/out.visopt-session");
+  {
+    QFile f(in);
+    QVERIFY(f.open(QIODevice::WriteOnly));
+    f.write(R"({"format":"visopt-session","version":5,)"
+            R"("data":{"builtin":"marschner-lobb","resolution":20},)"
+            R"("clearView":{"context":{"kind":"iso","isovalue":0.3},)"
+            R"("focus":{"kind":"iso","isovalue":0.7},)"
+            R"("deeperContexts":[{"kind":"iso","isovalue":0.5}],"weight":0.25}})");
+  }
+  for (const QString& form : {QStringLiteral("--session"), QStringLiteral("--session=")}) {
+    QFile::remove(out);
+    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+    env.insert(QStringLiteral("QT_QPA_PLATFORM"), QStringLiteral("offscreen"));
+    QProcess p;
+    p.setProgram(QStringLiteral(VISOPT_WORKSTATION));
+    QStringList args;
+    if (form.endsWith(QLatin1Char('=')))
+      args << form + in;
+    else
+      args << form << in;
+    args << QStringLiteral("--save-session") << out << QStringLiteral("--no-optimize")
+         << QStringLiteral("--state-dir") << dir + QStringLiteral("/state");
+    p.setArguments(args);
+    p.setProcessEnvironment(env);
+    p.setProcessChannelMode(QProcess::MergedChannels);
+    p.start();
+    QVERIFY2(p.waitForStarted(30000), qPrintable(p.errorString()));
+    QVERIFY2(p.waitForFinished(300000), "the workstation did not finish");
+    const QString log = QString::fromUtf8(p.readAll());
+    QVERIFY2(p.exitCode() == 0, qPrintable(log));
+    QFile f(out);
+    QVERIFY2(f.open(QIODevice::ReadOnly), qPrintable(form + QStringLiteral(": no session saved")));
+    const QByteArray text = f.readAll();
+    QVERIFY2(text.contains("\"marschner-lobb\"") && text.contains("\"resolution\": 20"),
+             qPrintable(form + QStringLiteral(": ") + QString::fromUtf8(text.left(300))));
+    QVERIFY2(text.contains("\"deeperContexts\""), qPrintable(form));
+  }
 }
 
 QTEST_MAIN(TestWorkstationScreenshot)

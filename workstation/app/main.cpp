@@ -4,6 +4,9 @@
 // session, export a screenshot after the first converged frame and quit, or measure the latency
 // from a camera drag to the preview on screen while the optimisation runs.
 #include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
 
 #include <QAction>
 #include <QActionGroup>
@@ -119,6 +122,20 @@ int runLatencyProbe(MainWindow& window, int steps, const QString& framesDir) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // QGuiApplication takes "-session NAME" (X11 session management) out of argv before our parser
+  // sees it, so "--session FILE" would open nothing: it reaches the parser as --open-session.
+  std::vector<std::string> args(argv, argv + argc);
+  for (size_t i = 1; i < args.size(); ++i) {
+    if (args[i] == "--") break;
+    for (const char* name : {"--session", "-session"})
+      if (args[i] == name || args[i].rfind(std::string(name) + "=", 0) == 0)
+        args[i] = "--open-session" + args[i].substr(std::strlen(name));
+  }
+  std::vector<char*> argvRenamed;
+  for (std::string& a : args) argvRenamed.push_back(a.data());
+  argvRenamed.push_back(nullptr);
+  argc = int(args.size());
+  argv = argvRenamed.data();
   QApplication app(argc, argv);
   QApplication::setApplicationName(QStringLiteral("visopt"));
   QApplication::setOrganizationName(QStringLiteral("visopt"));
@@ -132,8 +149,8 @@ int main(int argc, char** argv) {
   QCommandLineOption volume(QStringLiteral("volume"),
                             QStringLiteral("Open a volume file or DICOM folder."),
                             QStringLiteral("FILE"));
-  QCommandLineOption session(QStringLiteral("session"), QStringLiteral("Open a session."),
-                             QStringLiteral("FILE"));
+  QCommandLineOption session(QStringList{QStringLiteral("session"), QStringLiteral("open-session")},
+                             QStringLiteral("Open a session."), QStringLiteral("FILE"));
   QCommandLineOption resolution(QStringLiteral("resolution"),
                                 QStringLiteral("Built-in scene resolution (default 128)."),
                                 QStringLiteral("N"), QStringLiteral("128"));

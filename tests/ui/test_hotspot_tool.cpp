@@ -200,6 +200,7 @@ class TestHotspotTool : public QObject {
   void panelSettingsChangeTheFrame();
   void refusedCombinationsAreMessagesNotCrashes();
   void sessionKeepsTheHotspotSettings();
+  void secondLayersChangeTheFrameAndAreKept();
   void optimiseAroundTheHotspotMakesItTheImportance();
 };
 
@@ -566,6 +567,72 @@ void TestHotspotTool::sessionKeepsTheHotspotSettings() {
   QVERIFY(!w2->hotspotMode()->sessionSettings());
   QCOMPARE(w2->hotspotMode()->settings().measure, ClearViewMeasure::Curvature);
   QCOMPARE(w2->hotspotTool()->size(), 0.f);
+}
+
+// The second context and focus layers: switched on in the panel they extract new layers and
+// change the frame; a session keeps them; layers beyond the second (from a session or the
+// library) survive edits in the panel.
+void TestHotspotTool::secondLayersChangeTheFrameAndAreKept() {
+  const QString dir = freshDir(QStringLiteral("layers"));
+  auto w = openScene(QStringLiteral("layers-1"));
+  QVERIFY(settle(*w));
+  QVERIFY(pressH(*w));
+  QVERIFY(w->waitForSettledFrame(kSettleMs));
+  HotspotPanel* panel = w->hotspotPanel();
+  QVERIFY(!panel->deeperContextBox()->isChecked());
+  QVERIFY(!panel->deeperContextLayer()->isEnabled());
+  QVERIFY(w->hotspotMode()->settings().deeperContexts.empty());
+  ViewportWidget* view = w->viewport();
+  FrameLog log(view);
+  const QImage before = view->frame();
+  const int64_t extractions = w->hotspotMode()->lastStats()->extractions;
+
+  panel->deeperContextBox()->setChecked(true);
+  QVERIFY(panel->deeperContextLayer()->isEnabled());
+  const ClearViewSettings one = w->hotspotMode()->settings();
+  QCOMPARE(one.deeperContexts.size(), size_t(1));
+  QCOMPARE(one.deeperContexts[0].kind, ClearViewLayerKind::Isosurface);
+  const auto snap = w->controller()->snapshot();
+  const double lo = snap->volume->valueMin, hi = snap->volume->valueMax;
+  QVERIFY(std::abs(one.deeperContexts[0].isovalue - (lo + 0.75 * (hi - lo))) < 1e-6 * (hi - lo));
+  QVERIFY(w->waitForSettledFrame(kSettleMs));
+  QVERIFY2(w->hotspotMode()->problem().isEmpty(), qPrintable(w->hotspotMode()->problem()));
+  QVERIFY(log.frames.back().info.clearView);
+  QVERIFY(log.frames.back().info.clearViewStats.extractions > extractions);
+  QCOMPARE(log.frames.back().info.clearViewStats.deeperContextPixels.size(), size_t(1));
+  QVERIFY(differingPixels(view->frame(), before) > 0);
+
+  panel->secondFocusBox()->setChecked(true);
+  QCOMPARE(w->hotspotMode()->settings().moreFoci.size(), size_t(1));
+  QVERIFY(w->waitForSettledFrame(kSettleMs));
+  QVERIFY2(w->hotspotMode()->problem().isEmpty(), qPrintable(w->hotspotMode()->problem()));
+
+  // Saved and reopened: both second layers.
+  const ClearViewSettings set = w->hotspotMode()->settings();
+  const QString path = dir + QStringLiteral("/layers.visopt-session");
+  QVERIFY(w->saveSessionTo(path));
+  QVERIFY(sameHotspotSettings(*loadSession(path.toStdString()).clearView, set));
+  auto w2 = makeWindow(QStringLiteral("layers-2"));
+  QVERIFY(w2->openSession(path));
+  QVERIFY(w2->waitForSettledFrame(kSettleMs));
+  QVERIFY(sameHotspotSettings(w2->hotspotPanel()->settings(), set));
+  QVERIFY(w2->hotspotPanel()->deeperContextBox()->isChecked());
+  QVERIFY(w2->hotspotPanel()->secondFocusBox()->isChecked());
+
+  // Three context layers behind the first, as a session may hold them: an edit of the second in
+  // the panel keeps the third and fourth; switching it off removes them all.
+  ClearViewSettings many = set;
+  many.deeperContexts = {{ClearViewLayerKind::Isosurface, lo + 0.5 * (hi - lo), 0},
+                         {ClearViewLayerKind::Isosurface, lo + 0.6 * (hi - lo), 0},
+                         {ClearViewLayerKind::Isosurface, lo + 0.7 * (hi - lo), 0}};
+  panel->setSettings(many);
+  panel->deeperContextLayer()->isovalueBox()->setValue(lo + 0.55 * (hi - lo));
+  const ClearViewSettings edited = panel->settings();
+  QCOMPARE(edited.deeperContexts.size(), size_t(3));
+  QVERIFY(std::abs(edited.deeperContexts[0].isovalue - (lo + 0.55 * (hi - lo))) < 0.01 * (hi - lo));
+  QCOMPARE(edited.deeperContexts[2], many.deeperContexts[2]);
+  panel->deeperContextBox()->setChecked(false);
+  QVERIFY(panel->settings().deeperContexts.empty());
 }
 
 // "Optimise around the hotspot": the last frame's focus point and radius become the importance

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 
+#include "clearview_fixtures.h"
 #include "kernels/clearview_composite.h"
 #include "kernels/clearview_shading.h"
 #include "render/clearview.h"
@@ -20,63 +21,6 @@
 namespace visopt {
 namespace {
 
-constexpr int kN = 64;  // voxels per side, unit spacing, centred at the origin
-
-GridSpec cubeGrid() {
-  GridSpec g;
-  g.dims = {kN, kN, kN};
-  g.origin = glm::vec3(-0.5f * float(kN - 1));
-  return g;
-}
-
-Field3D fieldOf(const std::function<float(glm::vec3)>& f, Precision precision = Precision::FP32) {
-  const GridSpec g = cubeGrid();
-  Field3D out("field", g, precision);
-  for (int k = 0; k < kN; ++k)
-    for (int j = 0; j < kN; ++j)
-      for (int i = 0; i < kN; ++i)
-        out.set(g.linearIndex(i, j, k), f(g.indexToWorld(glm::vec3(i, j, k))));
-  return out;
-}
-
-// Inside-high ball of radius r about the origin (the value is the distance to the sphere).
-float ball(glm::vec3 x, float r) {
-  return r - glm::length(x);
-}
-
-Volume volumeOf(Field3D field, double lo, double hi) {
-  Volume v;
-  v.name = "analytic";
-  v.sourcePath = "test:analytic";
-  v.scalarType = "float32";
-  v.valueMin = lo;
-  v.valueMax = hi;
-  v.normalized = std::move(field);
-  return v;
-}
-
-Camera frontCamera() {
-  Camera c;
-  c.eye = glm::vec3(0.f, -120.f, 10.f);
-  c.target = glm::vec3(0.f);
-  c.up = glm::vec3(0.f, 0.f, 1.f);
-  c.fovYDegrees = 30.f;
-  return c;
-}
-
-// The exact first intersection of the ray of pixel (x, row) with the sphere |p| = r.
-bool exactSphereHit(const Camera& cam, const Bounds& bounds, int w, int h, int x, int row, float r,
-                    glm::vec3& hit) {
-  const FrustumGrid f = FrustumGrid::forCamera(cam, w, h, bounds, 1, 1.f);
-  const glm::vec3 d = f.rayDirection(float(x), float(h - 1 - row));
-  const glm::vec3 o = cam.eye;
-  const float b = glm::dot(o, d), c = glm::dot(o, o) - r * r;
-  const float disc = b * b - c;
-  if (disc < 0.f) return false;
-  hit = o + (-b - std::sqrt(disc)) * d;
-  return true;
-}
-
 struct Extracted {
   ClearViewLayers layers;
   Volume volume;
@@ -87,8 +31,8 @@ void extract(const Field3D& context, const Field3D& focus, int w, int h, ClearVi
              const Camera& cam = frontCamera()) {
   Volume v = volumeOf(fieldOf([](glm::vec3) { return 0.f; }), -1.0, 1.0);
   DeviceBuffer<glm::vec4> transfer;
-  extractClearViewLayers(v, transfer, cam, w, h, {&context, 0.f, 1.f}, {&focus, 0.f, 1.f}, false,
-                         out);
+  const ClearViewSurfaceSource contexts[] = {{&context, 0.f, 1.f}}, foci[] = {{&focus, 0.f, 1.f}};
+  extractClearViewLayers(v, transfer, cam, w, h, contexts, foci, false, out);
 }
 
 TEST(ClearViewExtraction, TheHitOnASphereLiesWithinATwentiethOfAVoxelOfTheExactOne) {
@@ -104,7 +48,7 @@ TEST(ClearViewExtraction, TheHitOnASphereLiesWithinATwentiethOfAVoxelOfTheExactO
     for (int row = 0; row < h; ++row)
       for (int x = 0; x < w; ++x) {
         const size_t i = size_t(row) * w + x;
-        glm::vec3 exact;
+        glm::vec3 exact(0.f);
         const bool expected = exactSphereHit(frontCamera(), bounds, w, h, x, row, r, exact);
         const bool got = L.contextDepth[i] < kClearViewNoHit;
         // Rays that graze the sphere within a voxel may go either way.
@@ -240,7 +184,7 @@ TEST(ClearViewMeasures, TheDistanceMeasuresEqualTheRadialGapAndTheRayGap) {
     for (int x = 0; x < w; ++x) {
       const size_t i = size_t(y) * w + x;
       if (!(L.contextDepth[i] < kClearViewNoHit)) continue;
-      glm::vec3 po;
+      glm::vec3 po(0.f);
       ASSERT_TRUE(exactSphereHit(frontCamera(), bounds, w, h, x, y, 24.f, po) ||
                   glm::length(L.contextPosition[i]) > 23.f);
       p.focusPoint = L.contextPosition[i];  // the distance term is 0 here
@@ -248,11 +192,11 @@ TEST(ClearViewMeasures, TheDistanceMeasuresEqualTheRadialGapAndTheRayGap) {
       // met after exactly the radial gap of 12.
       p.measure = ClearViewMeasureKind::Distance;
       EXPECT_NEAR(L.normalDistance[i], 12.f, 0.05f) << x << "," << y;
-      EXPECT_NEAR(clearViewContextOpacity(p, x, y), L.normalDistance[i] / 100.f, 1e-6f);
+      EXPECT_NEAR(clearViewContextOpacity(p, 0, x, y), L.normalDistance[i] / 100.f, 1e-6f);
       // §3.2.3: along the view ray, the gap between the two exact hits where the ray meets
       // both; opaque (1) where it misses the focus.
       p.measure = ClearViewMeasureKind::ViewDistance;
-      glm::vec3 pi;
+      glm::vec3 pi(0.f);
       if (exactSphereHit(frontCamera(), bounds, w, h, x, y, 12.f, pi) &&
           L.focusDepth[i] < kClearViewNoHit) {
         // Each hit within 0.05 voxel of its sphere; along a ray that meets a sphere at a
@@ -261,10 +205,10 @@ TEST(ClearViewMeasures, TheDistanceMeasuresEqualTheRadialGapAndTheRayGap) {
         if (-glm::dot(ray, glm::normalize(pi)) < 0.5f || -glm::dot(ray, glm::normalize(po)) < 0.5f)
           continue;
         const float gap = glm::length(pi - frontCamera().eye) - glm::length(po - frontCamera().eye);
-        EXPECT_NEAR(clearViewContextOpacity(p, x, y), gap / 100.f, 0.2f / 100.f);
+        EXPECT_NEAR(clearViewContextOpacity(p, 0, x, y), gap / 100.f, 0.2f / 100.f);
         ++both;
       } else if (!(L.focusDepth[i] < kClearViewNoHit)) {
-        EXPECT_EQ(clearViewContextOpacity(p, x, y), 1.f);
+        EXPECT_EQ(clearViewContextOpacity(p, 0, x, y), 1.f);
         ++outerOnly;
       }
     }
@@ -283,7 +227,7 @@ TEST(ClearViewCompositing, TheBorderIsExactlyThePixelsAtZeroNinetyFiveToOneSize)
   cv.size = 15.f;
   cv.contextShader = cv.focusShader = ClearViewShader::Diffuse;
   cv.ambient = 1.f;  // unshaded: the border's darkening is the only difference
-  glm::vec3 C;
+  glm::vec3 C(0.f);
   ASSERT_TRUE(clearViewFocusPoint(L, cv.focusPixel, C));
   EXPECT_NEAR(glm::length(C), 12.f, 0.05f);  // the centre pixel projected onto the focus
   const Camera cam = frontCamera();

@@ -149,10 +149,41 @@ TEST(CliClearView, MalformedSpecsAreUsageErrorsNamingTheElement) {
       {"border=2", "border=2"},
       {"size=10,,weight=1", "empty element 2"},  // empty element
       {"size=10,", "empty element 2"},
+      // a fifth context layer (at most four), and a bad one among several
+      {"context=iso:0.1,context=iso:0.2,context=iso:0.3,context=iso:0.4,context=iso:0.5",
+       "context=iso:0.5"},
+      {"focus=importance,focus=iso:abc", "focus=iso:abc"},
       {"=3", "=3"},
       {"size=", "size="},
   };
   for (const auto& [spec, names] : cases) expectRefused(kShepp, out, spec, names);
+}
+
+// context= and focus= repeat: the further context layers lie behind the first (each is reported
+// with its pixels), each pixel shows the nearest focus layer.
+TEST(CliClearView, RepeatedLayerKeysAddLayersInOrder) {
+  const std::string out = tmp("layers-more.png");
+  fs::remove(out);
+  const Result r = run(kShepp + out +
+                       " --clearview 'context=iso:0.1,context=iso:0.5,focus=importance,"
+                       "focus=iso:0.9' --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto cv = nlohmann::json::parse(r.out)["clearview"];
+  EXPECT_EQ(cv["context"], "iso:0.1");
+  ASSERT_EQ(cv["deeper_contexts"].size(), 1u) << cv;
+  EXPECT_EQ(cv["deeper_contexts"][0]["layer"], "iso:0.5");
+  EXPECT_GT(cv["deeper_contexts"][0]["pixels"].get<long long>(), 0);
+  EXPECT_LE(cv["deeper_contexts"][0]["pixels"].get<long long>(),
+            cv["context_pixels"].get<long long>());
+  EXPECT_EQ(cv["focus"], "importance:0.5");
+  EXPECT_EQ(cv["more_foci"], nlohmann::json::array({"iso:0.9"}));
+  EXPECT_TRUE(fs::exists(out));
+  // One layer each: no lists.
+  const Result one = run(kShepp + out + " --clearview context=iso:0.1 --json");
+  ASSERT_EQ(one.code, 0) << one.err;
+  const auto cv1 = nlohmann::json::parse(one.out)["clearview"];
+  EXPECT_FALSE(cv1.contains("deeper_contexts"));
+  EXPECT_FALSE(cv1.contains("more_foci"));
 }
 
 TEST(CliClearView, LayersMustExistInTheScene) {

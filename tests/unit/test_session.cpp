@@ -318,9 +318,9 @@ TEST(Session, OlderVersionsLoadThroughTheMigrations) {
   EXPECT_EQ(engine.camera().fovYDegrees, 25.f);
 }
 
-// The ClearView hotspot's settings (version 4): every stored member comes back; width, height and
-// the focus pixel belong to the view and are not stored; only the layers and non-defaults are
-// written.
+// The ClearView hotspot's settings (versions 4 and 5): every stored member comes back; width,
+// height and the focus pixel belong to the view and are not stored; only the layers and
+// non-defaults are written.
 TEST(Session, ClearViewSettingsRoundTripEveryField) {
   const fs::path dir = freshDir("clearview");
   const std::string path = (dir / "hotspot.visopt-session").string();
@@ -335,6 +335,9 @@ TEST(Session, ClearViewSettingsRoundTripEveryField) {
   c.focusPixel = {12.f, 34.f};
   c.context = {ClearViewLayerKind::Isosurface, 0.37, 0};
   c.focus = {ClearViewLayerKind::ContextSurface, 0.0, 2};
+  c.deeperContexts = {{ClearViewLayerKind::Isosurface, 0.61, 0},
+                      {ClearViewLayerKind::ContextSurface, 0.0, 1}};
+  c.moreFoci = {{ClearViewLayerKind::Importance, 0.25, 0}};
   c.volumeLayer = true;
   c.measure = ClearViewMeasure::ViewDistance;
   c.contextShader = ClearViewShader::CoolWarm;
@@ -363,6 +366,8 @@ TEST(Session, ClearViewSettingsRoundTripEveryField) {
   const ClearViewSettings& r = *loaded.clearView;
   EXPECT_EQ(r.context, c.context);
   EXPECT_EQ(r.focus, c.focus);
+  EXPECT_EQ(r.deeperContexts, c.deeperContexts);
+  EXPECT_EQ(r.moreFoci, c.moreFoci);
   EXPECT_EQ(r.volumeLayer, c.volumeLayer);
   EXPECT_EQ(r.measure, c.measure);
   EXPECT_EQ(r.contextShader, c.contextShader);
@@ -381,7 +386,12 @@ TEST(Session, ClearViewSettingsRoundTripEveryField) {
   EXPECT_EQ(r.focusPixel, d.focusPixel);
   EXPECT_EQ(readText(path), sessionToJson(loaded, path));
   const auto doc = nlohmann::json::parse(readText(path));
-  EXPECT_EQ(doc["version"], 4);
+  EXPECT_EQ(doc["version"], 5);
+  EXPECT_EQ(
+      doc["clearView"]["deeperContexts"],
+      nlohmann::json::parse(R"([{"kind":"iso","isovalue":0.61},{"kind":"surface","surface":1}])"));
+  EXPECT_EQ(doc["clearView"]["moreFoci"],
+            nlohmann::json::parse(R"([{"kind":"importance","isovalue":0.25}])"));
   EXPECT_EQ(doc["clearView"]["context"],
             nlohmann::json::parse(R"({"kind":"iso","isovalue":0.37})"));
   EXPECT_EQ(doc["clearView"]["focus"], nlohmann::json::parse(R"({"kind":"surface","surface":2})"));
@@ -412,6 +422,46 @@ TEST(Session, ClearViewSettingsRoundTripEveryField) {
   const SessionLoadReport report = applySession(restored, loaded, path);
   EXPECT_TRUE(report.sceneLoaded);
   for (const auto& w : report.warnings) ADD_FAILURE() << w;
+}
+
+// Version 4 had one context and one focus layer: a version-4 reader ignored "deeperContexts" and
+// "moreFoci", so in a version-4 file they are not visopt's and are dropped, not read as layers.
+// Damaged lists in a version-5 file are refused, naming the key.
+TEST(Session, VersionFourHasOneLayerEachAndBadLayerListsAreRefused) {
+  const std::string head =
+      R"({"format":"visopt-session","version":VERSION,"data":{"builtin":"marschner-lobb",)"
+      R"("resolution":16},"clearView":{"context":{"kind":"surface","surface":0},)"
+      R"("focus":{"kind":"importance","isovalue":0.5},)";
+  auto doc = [&](const std::string& version, const std::string& rest) {
+    std::string text = head;
+    text.replace(text.find("VERSION"), 7, version);
+    return text + rest + "}}";
+  };
+  const Session v4 =
+      sessionFromJson(doc("4", R"("moreFoci":[{"kind":"iso","isovalue":1}],"weight":0.5)"), "v4");
+  ASSERT_TRUE(v4.clearView);
+  EXPECT_TRUE(v4.clearView->moreFoci.empty());
+  EXPECT_EQ(v4.clearView->weight, 0.5f);
+  const Session v5 = sessionFromJson(doc("5", R"("moreFoci":[{"kind":"iso","isovalue":1}])"), "v5");
+  ASSERT_TRUE(v5.clearView);
+  ASSERT_EQ(v5.clearView->moreFoci.size(), 1u);
+  EXPECT_EQ(v5.clearView->moreFoci[0].isovalue, 1.0);
+  for (const std::string& bad :
+       {std::string(R"("moreFoci":{"kind":"iso","isovalue":1})"),
+        std::string(R"("deeperContexts":[{"kind":"importance","isovalue":3}])"),
+        std::string(R"("deeperContexts":[{"kind":"iso","isovalue":1},{"kind":"iso","isovalue":1},)"
+                    R"({"kind":"iso","isovalue":1},{"kind":"iso","isovalue":1}])")}) {
+    try {
+      (void)sessionFromJson(doc("5", bad), "bad.visopt-session");
+      ADD_FAILURE() << bad;
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("bad.visopt-session"), std::string::npos) << what;
+      EXPECT_TRUE(what.find("moreFoci") != std::string::npos ||
+                  what.find("deeperContexts") != std::string::npos)
+          << what;
+    }
+  }
 }
 
 // Version 3 had no hotspot settings: such a file loads with none (the scene's defaults), and a

@@ -10,11 +10,11 @@
 namespace visopt::ws {
 
 bool sameHotspotSettings(const ClearViewSettings& a, const ClearViewSettings& b) {
-  return a.context == b.context && a.focus == b.focus && a.volumeLayer == b.volumeLayer &&
-         a.measure == b.measure && a.contextShader == b.contextShader &&
-         a.focusShader == b.focusShader && a.size == b.size && a.weight == b.weight &&
-         a.distanceScale == b.distanceScale && a.border == b.border && a.ambient == b.ambient &&
-         a.headlight == b.headlight && a.contextColor == b.contextColor &&
+  return a.context == b.context && a.focus == b.focus && a.deeperContexts == b.deeperContexts &&
+         a.moreFoci == b.moreFoci && a.volumeLayer == b.volumeLayer && a.measure == b.measure &&
+         a.contextShader == b.contextShader && a.focusShader == b.focusShader && a.size == b.size &&
+         a.weight == b.weight && a.distanceScale == b.distanceScale && a.border == b.border &&
+         a.ambient == b.ambient && a.headlight == b.headlight && a.contextColor == b.contextColor &&
          a.focusColor == b.focusColor && a.background == b.background;
 }
 

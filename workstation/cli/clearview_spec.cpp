@@ -177,11 +177,24 @@ ClearViewSettings parseClearViewSpec(const Engine& engine, const std::string& sp
     const std::string_view value = trim(element.substr(eq + 1));
     if (key.empty()) fail(element, "no key before '='");
     if (value.empty()) fail(element, "no value after '='");
-    if (!seen.insert(std::string(key)).second)
-      fail(element, "'" + std::string(key) + "' is given twice");
+    const bool layerKey = key == "context" || key == "focus";
+    const bool first = seen.insert(std::string(key)).second;
+    if (!first && !layerKey) fail(element, "'" + std::string(key) + "' is given twice");
 
-    if (key == "context" || key == "focus") {
-      (key == "context" ? s.context : s.focus) = parseLayer(engine, element, key, value);
+    if (layerKey) {
+      // The first context= (focus=) replaces the defaults' layers; each further one adds a layer
+      // behind it (another focus surface), in the order given.
+      const bool context = key == "context";
+      std::vector<ClearViewLayer>& more = context ? s.deeperContexts : s.moreFoci;
+      if (first) more.clear();
+      if (!first && more.size() + 1 >= size_t(kClearViewMaxLayers))
+        fail(element,
+             "at most " + std::to_string(kClearViewMaxLayers) + " " + std::string(key) + " layers");
+      const ClearViewLayer layer = parseLayer(engine, element, key, value);
+      if (first)
+        (context ? s.context : s.focus) = layer;
+      else
+        more.push_back(layer);
     } else if (key == "volume") {
       s.volumeLayer = flag(element, value);
     } else if (key == "measure") {

@@ -18,6 +18,8 @@ namespace visopt::cli {
 //   context=iso:V | surface:N | importance:G     (default surface:0 when the scene has one)
 //   focus=iso:V | surface:N | importance:G | importance   (default importance:0.5 when the
 //                                                          scene has an importance)
+//   (context= and focus= may repeat, up to kClearViewMaxLayers each: the further context layers
+//   lie behind the first, in the order given; each pixel shows the nearest focus layer)
 //   volume=0|1  measure=curvature|distance|view-distance
 //   shader=, focus-shader=diffuse|cool-warm|skin|bone
 //   at=PX:PY  size=MM  weight=W  distance-scale=MM  border=0|1  ambient=A  light=camera|scene

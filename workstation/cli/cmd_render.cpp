@@ -173,6 +173,16 @@ Runner addRenderCommand(CLI::App& app) {
                             {"clearview_composite_ms", cvStats.compositeMs},
                             {"stages", stageTimingsJson()},
                             {"memory", ledgerJson(engine.ledger())}};
+        // The further layers, when there are any, in the order SPEC gives them.
+        nlohmann::json deeper = nlohmann::json::array(), more = nlohmann::json::array();
+        for (size_t i = 0; i < cv.deeperContexts.size(); ++i)
+          deeper.push_back(
+              {{"layer", describeClearViewLayer(cv.deeperContexts[i])},
+               {"pixels", i < cvStats.deeperContextPixels.size() ? cvStats.deeperContextPixels[i]
+                                                                 : int64_t(0)}});
+        for (const ClearViewLayer& l : cv.moreFoci) more.push_back(describeClearViewLayer(l));
+        if (!deeper.empty()) j["clearview"]["deeper_contexts"] = deeper;
+        if (!more.empty()) j["clearview"]["more_foci"] = more;
         if (session) j["session"] = {{"path", o->session}, {"data", sessionData}};
         std::printf("%s\n", j.dump(2).c_str());
       } else {

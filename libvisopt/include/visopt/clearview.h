@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -41,10 +42,23 @@ const char* toString(ClearViewMeasure measure);
 enum class ClearViewShader { Diffuse, CoolWarm, Skin, Bone };
 const char* toString(ClearViewShader shader);
 
+// At most this many context and this many focus surface layers.
+inline constexpr int kClearViewMaxLayers = 4;
+
 struct ClearViewSettings {
   int width = 512, height = 512;
-  ClearViewLayer context;  // the semi-transparent context surface
-  ClearViewLayer focus{ClearViewLayerKind::Importance, 0.5, 0};  // the opaque focus surface
+  ClearViewLayer context;  // the nearest semi-transparent context surface
+  // Further context surfaces behind it, front to back (§3.1: "one or more context layers"). Each
+  // is found along the ray from where the one before it was hit (from where the ray enters the
+  // volume where that one has no hit), so the user orders them front to back, as the paper asks;
+  // each is made transparent about the focus point by its own measure, and they are blended
+  // back to front. At most kClearViewMaxLayers - 1.
+  std::vector<ClearViewLayer> deeperContexts;
+  ClearViewLayer focus{ClearViewLayerKind::Importance, 0.5, 0};  // an opaque focus surface
+  // Further opaque focus surfaces ("one or more focus layers"): each pixel shows the nearest hit
+  // of all focus surfaces, and the focus point C is the cursor's pixel on that nearest one. At
+  // most kClearViewMaxLayers - 1.
+  std::vector<ClearViewLayer> moreFoci;
   // Also a volume context layer: all matter in front of the first context or focus surface,
   // composited front to back with the transfer function (emission-absorption: the albedo as
   // emitted colour, no shading), made transparent around the focus point like the surface but
@@ -85,7 +99,9 @@ struct ClearViewStats {
   double compositeMs = 0.0;  // this call's compositing
   bool hasFocusPoint = false;
   glm::vec3 focusPoint{0.f};  // C in world units, when the focus pixel sees the focus layer
-  int64_t contextPixels = 0, focusPixels = 0;  // pixels where each surface layer was hit
+  // Pixels where the first context surface and where any focus surface was hit.
+  int64_t contextPixels = 0, focusPixels = 0;
+  std::vector<int64_t> deeperContextPixels;  // the same per deeper context surface
   float size = 0.f;  // the hotspot radius s used, world units (the automatic one when size was 0)
 };
 

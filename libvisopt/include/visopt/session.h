@@ -39,7 +39,8 @@ namespace visopt {
 //   2: camera stored as {"eye", "target", "up", "fovY"}
 //   3: "tf" renamed "transferFunction", "surfaces" renamed "contextSurfaces"
 //   4: "clearView" (the ClearView hotspot's settings) and the importance kind "hotspot"
-inline constexpr int kSessionFormatVersion = 4;
+//   5: "clearView" may list more layers: "deeperContexts" and "moreFoci"
+inline constexpr int kSessionFormatVersion = 5;
 
 // ---- data references ----------------------------------------------------------------------
 

@@ -16,9 +16,8 @@ bool sameCamera(const Camera& a, const Camera& b) {
 
 bool ClearViewCache::Key::operator==(const Key& o) const {
   return sameCamera(camera, o.camera) && width == o.width && height == o.height &&
-         context == o.context && focus == o.focus && volumeLayer == o.volumeLayer &&
-         volumeData == o.volumeData && contextField == o.contextField &&
-         focusField == o.focusField && transferToken == o.transferToken &&
+         layers == o.layers && contextCount == o.contextCount && volumeLayer == o.volumeLayer &&
+         volumeData == o.volumeData && fields == o.fields && transferToken == o.transferToken &&
          sceneRevision == o.sceneRevision && importanceRevision == o.importanceRevision;
 }
 
@@ -32,12 +31,17 @@ void ClearViewCache::render(const ClearViewInputs& in, const ClearViewSettings& 
   key.camera = in.camera;
   key.width = settings.width;
   key.height = settings.height;
-  key.context = settings.context;
-  key.focus = settings.focus;
+  key.layers.push_back(settings.context);
+  key.layers.insert(key.layers.end(), settings.deeperContexts.begin(),
+                    settings.deeperContexts.end());
+  key.contextCount = key.layers.size();
+  key.layers.push_back(settings.focus);
+  key.layers.insert(key.layers.end(), settings.moreFoci.begin(), settings.moreFoci.end());
   key.volumeLayer = settings.volumeLayer;
   key.volumeData = in.volume->normalized.raw();
-  key.contextField = in.context.field ? in.context.field->raw() : nullptr;
-  key.focusField = in.focus.field ? in.focus.field->raw() : nullptr;
+  for (const auto* sources : {&in.contexts, &in.foci})
+    for (const ClearViewSurfaceSource& s : *sources)
+      key.fields.push_back(s.field ? s.field->raw() : nullptr);
   key.transferToken = in.transferToken;
   key.sceneRevision = in.sceneRevision;
   key.importanceRevision = in.importanceRevision;
@@ -49,7 +53,7 @@ void ClearViewCache::render(const ClearViewInputs& in, const ClearViewSettings& 
     const auto start = std::chrono::steady_clock::now();
     key_.reset();  // a failed extraction leaves no layers that claim to be current
     extractClearViewLayers(*in.volume, *in.transfer, in.camera, settings.width, settings.height,
-                           in.context, in.focus, settings.volumeLayer, layers_);
+                           in.contexts, in.foci, settings.volumeLayer, layers_);
     key_ = key;
     ++extractions_;
     st.extracted = true;

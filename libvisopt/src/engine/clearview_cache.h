@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "core/device_buffer.h"
 #include "render/clearview.h"
@@ -22,7 +23,9 @@ struct ClearViewInputs {
   int transferToken = 0;  // changes with every bake of the transfer function
   Camera camera;
   PointLight light;
-  ClearViewSurfaceSource context, focus;
+  // The context surfaces front to back, then the focus surfaces (settings.context first, then
+  // its deeperContexts; settings.focus first, then its moreFoci).
+  std::vector<ClearViewSurfaceSource> contexts, foci;
   // Counters the Engine advances when the volume, the context surfaces (also as the optimisation
   // moves them) or the importance change.
   uint64_t sceneRevision = 0, importanceRevision = 0;
@@ -43,11 +46,11 @@ class ClearViewCache {
   struct Key {
     Camera camera;
     int width = 0, height = 0;
-    ClearViewLayer context, focus;
+    std::vector<ClearViewLayer> layers;  // the contexts, then the foci
+    size_t contextCount = 0;
     bool volumeLayer = false;
     const void* volumeData = nullptr;
-    const void* contextField = nullptr;
-    const void* focusField = nullptr;
+    std::vector<const void*> fields;  // of each layer
     int transferToken = 0;
     uint64_t sceneRevision = 0, importanceRevision = 0;
     bool operator==(const Key& o) const;

@@ -387,9 +387,8 @@ void Engine::renderClearView(const ClearViewSettings& settings, Image& image,
   checkCamera(impl_->camera, bounds);
   checkLight(impl_->light, bounds);
   impl_->ensureTable();
-  const auto source = [&](const ClearViewLayer& layer, const char* role) {
+  const auto source = [&](const ClearViewLayer& layer, const std::string& r) {
     ClearViewSurfaceSource s;
-    const std::string r = role;
     switch (layer.kind) {
       case ClearViewLayerKind::Isosurface:
         if (!(layer.isovalue > volume.valueMin && layer.isovalue < volume.valueMax))
@@ -425,8 +424,12 @@ void Engine::renderClearView(const ClearViewSettings& settings, Image& image,
   in.transferToken = impl_->tableToken;
   in.camera = impl_->camera;
   in.light = impl_->light;
-  in.context = source(settings.context, "context");
-  in.focus = source(settings.focus, "focus");
+  in.contexts.push_back(source(settings.context, "context"));
+  for (size_t i = 0; i < settings.deeperContexts.size(); ++i)
+    in.contexts.push_back(source(settings.deeperContexts[i], "context " + std::to_string(i + 2)));
+  in.foci.push_back(source(settings.focus, "focus"));
+  for (size_t i = 0; i < settings.moreFoci.size(); ++i)
+    in.foci.push_back(source(settings.moreFoci[i], "focus " + std::to_string(i + 2)));
   in.sceneRevision = impl_->sceneRevision;
   in.importanceRevision = impl_->importanceRevision;
   if (!impl_->clearView) impl_->clearView = std::make_unique<ClearViewCache>(&impl_->ledger);

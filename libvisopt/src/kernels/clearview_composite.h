@@ -1,6 +1,7 @@
 // ClearView's compositing (Krüger, Schneider, Westermann 2006, §3.2): per pixel, the context's
 // opacity from the focus point and the importance measure, the shaders, the focus border, and
-// the blend of the volume layer, the context surface, the focus surface and the background.
+// the blend of the volume layer, the context surfaces (back to front, each by its own opacity),
+// the nearest focus surface and the background.
 //   curvature (§3.2.1): sum over the 4 neighbours of |N(p) - N(q)| (the umbrella operator in
 //     image space); a neighbour without a hit counts as the largest difference of two unit
 //     normals, 2, so silhouettes stay opaque;
@@ -24,12 +25,17 @@ inline constexpr int kClearViewDecodeEntries = 4096;
 
 enum class ClearViewMeasureKind : int { Curvature = 0, Distance = 1, ViewDistance = 2 };
 
+struct ClearViewContextView {
+  const glm::vec3 *position = nullptr, *normal = nullptr;
+  const float* depth = nullptr;
+  const float* normalDistance = nullptr;
+};
+
 struct ClearViewLayersView {
-  const glm::vec3 *contextPosition = nullptr, *contextNormal = nullptr;
-  const float* contextDepth = nullptr;
+  ClearViewContextView contexts[kClearViewMaxLayers];  // nearest first
+  int contextCount = 1;
   const glm::vec3 *focusPosition = nullptr, *focusNormal = nullptr;
   const float* focusDepth = nullptr;
-  const float* normalDistance = nullptr;
   const glm::vec4* volume = nullptr;  // null without a volume layer
 };
 
@@ -87,25 +93,26 @@ VISOPT_HD inline float clearViewColorEdges(const glm::vec4* volume, int w, int h
   return sum;
 }
 
-// The context's opacity at a pixel with a context hit (the measure's term and the distance
-// term), before the border.
-VISOPT_HD inline float clearViewContextOpacity(const ClearViewCompositeParams& p, int x, int y) {
+// The opacity of context layer `layer` at a pixel where it has a hit (the measure's term and the
+// distance term), before the border.
+VISOPT_HD inline float clearViewContextOpacity(const ClearViewCompositeParams& p, int layer, int x,
+                                               int y) {
   const int64_t i = int64_t(y) * p.width + x;
-  const ClearViewLayersView& L = p.layers;
+  const ClearViewContextView& C = p.layers.contexts[layer];
+  const float* focusDepth = p.layers.focusDepth;
   if (!p.hasFocusPoint) return 1.f;
-  const float near = glm::length(p.focusPoint - L.contextPosition[i]) * p.invSize;
+  const float near = glm::length(p.focusPoint - C.position[i]) * p.invSize;
   float m = 0.f;
   switch (p.measure) {
     case ClearViewMeasureKind::Distance:
-      m = L.normalDistance[i] >= kClearViewNoHit ? 1.f : L.normalDistance[i] * p.invDistance;
+      m = C.normalDistance[i] >= kClearViewNoHit ? 1.f : C.normalDistance[i] * p.invDistance;
       break;
     case ClearViewMeasureKind::ViewDistance:
-      m = L.focusDepth[i] >= kClearViewNoHit
-              ? 1.f
-              : fabsf(L.focusDepth[i] - L.contextDepth[i]) * p.invDistance;
+      m = focusDepth[i] >= kClearViewNoHit ? 1.f
+                                           : fabsf(focusDepth[i] - C.depth[i]) * p.invDistance;
       break;
     default:
-      m = clearViewCurvature(L.contextNormal, L.contextDepth, p.width, p.height, x, y);
+      m = clearViewCurvature(C.normal, C.depth, p.width, p.height, x, y);
   }
   return cvSaturate(maxOf(near, p.weight * m));
 }
@@ -116,20 +123,25 @@ struct ClearViewCompositeKernel {
   VISOPT_HD void operator()(int64_t pixel) const {
     const int x = int(pixel % p.width), y = int(pixel / p.width);
     const ClearViewLayersView& L = p.layers;
-    const float tc = L.contextDepth[pixel], tf = L.focusDepth[pixel];
+    const float tf = L.focusDepth[pixel];
     glm::vec3 color = p.background;
+    float near = 1.f;  // the distance term of the front-most layer drawn, for the volume layer
     if (tf < kClearViewNoHit) {
       const glm::vec3 P = L.focusPosition[pixel];
       color = clearViewShade(p.focusShader, L.focusNormal[pixel], lightAt(P), eyeAt(P),
                              p.focusColor, p.ambient);
+      if (p.hasFocusPoint) near = cvSaturate(glm::length(p.focusPoint - P) * p.invSize);
     }
-    // The context surface lies over the focus unless the focus is in front of it.
-    float near = 1.f;  // the distance term at this pixel, for the volume layer
-    if (tc < kClearViewNoHit && !(tf < tc)) {
-      const glm::vec3 P = L.contextPosition[pixel];
-      glm::vec3 c = clearViewShade(p.contextShader, L.contextNormal[pixel], lightAt(P), eyeAt(P),
+    // The context surfaces, back to front, each over what lies behind it unless the focus is in
+    // front of it.
+    for (int k = L.contextCount - 1; k >= 0; --k) {
+      const ClearViewContextView& C = L.contexts[k];
+      const float tc = C.depth[pixel];
+      if (!(tc < kClearViewNoHit) || tf < tc) continue;
+      const glm::vec3 P = C.position[pixel];
+      glm::vec3 c = clearViewShade(p.contextShader, C.normal[pixel], lightAt(P), eyeAt(P),
                                    p.contextColor, p.ambient);
-      const float alpha = clearViewContextOpacity(p, x, y);
+      const float alpha = clearViewContextOpacity(p, k, x, y);
       if (p.hasFocusPoint) {
         const float d = glm::length(p.focusPoint - P) * p.invSize;
         near = cvSaturate(d);
@@ -137,8 +149,6 @@ struct ClearViewCompositeKernel {
         if (p.border && d >= 0.95f && d <= 1.f) c *= 0.3f;
       }
       color = alpha * c + (1.f - alpha) * color;
-    } else if (tf < kClearViewNoHit && p.hasFocusPoint) {
-      near = cvSaturate(glm::length(p.focusPoint - L.focusPosition[pixel]) * p.invSize);
     }
     if (L.volume) {  // premultiplied, made transparent about the focus point like the surface
       const glm::vec4 v = L.volume[pixel];

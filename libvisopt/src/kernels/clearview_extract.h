@@ -1,10 +1,12 @@
 // ClearView's layer extraction (Krüger, Schneider, Westermann 2006, §3.1): per pixel, the first
-// hit of the view ray with the context surface and with the focus surface (world position,
-// outward normal from the central-difference gradient at the hit, depth along the ray), the
-// distance from the context hit to the focus surface along the context's inward normal (the
-// distance-based measure, §3.2.2: the paper's extra pass from the position texture along the
-// normal texture), and optionally the volume layer: the transfer function's matter in front of
-// the first surface, composited front to back.
+// hit of the view ray with each context surface, the next one searched from where the one before
+// it was hit ("the positions stored in the current texture are used as starting points for the
+// ray-caster"), and the nearest hit of the focus surfaces (world position, outward normal from
+// the central-difference gradient at the hit, depth along the ray); for each context hit the
+// distance to the nearest focus surface along the context's inward normal (the distance-based
+// measure, §3.2.2: the paper's extra pass from the position texture along the normal texture);
+// and optionally the volume layer: the transfer function's matter in front of the first surface,
+// composited front to back.
 #pragma once
 
 #include <cmath>
@@ -18,6 +20,7 @@
 #include "core/min_max.h"
 #include "kernels/ray_box.h"
 #include "kernels/transfer_lookup.h"
+#include "visopt/clearview.h"
 
 namespace visopt {
 
@@ -72,11 +75,13 @@ struct ClearViewSurfaceOut {
 struct ClearViewExtractParams {
   FrustumMap camera;  // dims.x, dims.y = image size
   GridMap volume;
-  ClearViewSurfaceField context, focus;
+  ClearViewSurfaceField contexts[kClearViewMaxLayers], foci[kClearViewMaxLayers];
+  int contextCount = 1, focusCount = 1;
   float step = 0.5f;              // world units
   float maxNormalDistance = 0.f;  // how far the distance measure looks, world units
-  ClearViewSurfaceOut contextOut, focusOut;
-  float* normalDistance = nullptr;  // kClearViewNoHit where the focus is not found
+  ClearViewSurfaceOut contextOut[kClearViewMaxLayers], focusOut;
+  // Per context layer; kClearViewNoHit where no focus surface is found.
+  float* normalDistance[kClearViewMaxLayers] = {};
   // The volume layer (optional): normalised scalars and the baked transfer table.
   bool volumeLayer = false;
   FieldView scalars;
@@ -146,8 +151,9 @@ VISOPT_HD inline glm::vec3 clearViewNormal(const ClearViewSurfaceField& s, const
 struct ClearViewExtractKernel {
   ClearViewExtractParams p;
 
-  // A context hit counts 1 and a focus hit kFocusHit in the value a pixel returns, so that one
-  // sum over the image gives both layers' pixel counts (at most 16384^2 < 2^32 pixels).
+  // A hit on the first context surface counts 1 and a focus hit kFocusHit in the value a pixel
+  // returns, so that one sum over the image gives both pixel counts (at most 16384^2 < 2^32
+  // pixels); the deeper context layers are counted from their depths afterwards.
   static constexpr int64_t kFocusHit = int64_t(1) << 32;
 
   // One pixel; returns its hits as above.
@@ -159,48 +165,72 @@ struct ClearViewExtractKernel {
     const glm::vec3 o = p.volume.toIndex(p.camera.eye);
     const glm::vec3 d = p.volume.directionToIndex(dirWorld);
     const RayInterval box = intersectBox(o, d, glm::vec3(p.volume.dims - 1));
-    int64_t hits = 0;
-    float tc = kClearViewNoHit, tf = kClearViewNoHit;
     const bool inBox = !box.empty();
-    if (inBox && clearViewFirstHit(p.context, o, d, box.t0, box.t1, p.step, tc)) {
-      const glm::vec3 idx = o + tc * d;
-      p.contextOut.position[pixel] = p.volume.toWorld(idx);
-      glm::vec3 n = clearViewNormal(p.context, p.volume, idx);
-      if (n == glm::vec3(0.f)) n = -dirWorld;  // a flat field: face the viewer
-      p.contextOut.normal[pixel] = n;
-      ++hits;
-      // §3.2.2: along the inward normal to the focus surface, starting a step inside.
-      float dist = kClearViewNoHit;
-      if (p.maxNormalDistance > 0.f) {
-        const glm::vec3 dn = p.volume.directionToIndex(-n);
-        const RayInterval nbox = intersectBox(idx, dn, glm::vec3(p.volume.dims - 1));
-        const float end = minOf(nbox.t1, p.maxNormalDistance);
-        float tn;
-        if (!nbox.empty() && clearViewFirstHit(p.focus, idx, dn, 0.f, end, p.step, tn)) dist = tn;
+    int64_t hits = 0;
+    // The nearest focus hit: each further focus surface is searched only up to it.
+    float tf = kClearViewNoHit;
+    int nearest = -1;
+    for (int k = 0; k < p.focusCount && inBox; ++k) {
+      float t;
+      if (clearViewFirstHit(p.foci[k], o, d, box.t0, minOf(box.t1, tf), p.step, t) && t < tf) {
+        tf = t;
+        nearest = k;
       }
-      p.normalDistance[pixel] = dist;
-    } else {
-      tc = kClearViewNoHit;
-      p.contextOut.position[pixel] = glm::vec3(0.f);
-      p.contextOut.normal[pixel] = glm::vec3(0.f);
-      p.normalDistance[pixel] = kClearViewNoHit;
     }
-    p.contextOut.depth[pixel] = tc;
-    if (inBox && clearViewFirstHit(p.focus, o, d, box.t0, box.t1, p.step, tf)) {
+    if (nearest >= 0) {
       const glm::vec3 idx = o + tf * d;
       p.focusOut.position[pixel] = p.volume.toWorld(idx);
-      glm::vec3 n = clearViewNormal(p.focus, p.volume, idx);
-      if (n == glm::vec3(0.f)) n = -dirWorld;
+      glm::vec3 n = clearViewNormal(p.foci[nearest], p.volume, idx);
+      if (n == glm::vec3(0.f)) n = -dirWorld;  // a flat field: face the viewer
       p.focusOut.normal[pixel] = n;
       hits += kFocusHit;
     } else {
-      tf = kClearViewNoHit;
       p.focusOut.position[pixel] = glm::vec3(0.f);
       p.focusOut.normal[pixel] = glm::vec3(0.f);
     }
     p.focusOut.depth[pixel] = tf;
-    if (p.volumeLayer) p.volumeOut[pixel] = volumeInFront(o, d, box, minOf(tc, tf));
+    float start = box.t0, tFirst = kClearViewNoHit;
+    for (int k = 0; k < p.contextCount; ++k) {
+      const ClearViewSurfaceOut& out = p.contextOut[k];
+      float tc = kClearViewNoHit;
+      if (inBox && clearViewFirstHit(p.contexts[k], o, d, start, box.t1, p.step, tc)) {
+        const glm::vec3 idx = o + tc * d;
+        out.position[pixel] = p.volume.toWorld(idx);
+        glm::vec3 n = clearViewNormal(p.contexts[k], p.volume, idx);
+        if (n == glm::vec3(0.f)) n = -dirWorld;
+        out.normal[pixel] = n;
+        if (k == 0) {
+          ++hits;
+          tFirst = tc;
+        }
+        p.normalDistance[k][pixel] = distanceToFocus(idx, n);
+        start = tc;  // the next context layer is searched from here
+      } else {
+        tc = kClearViewNoHit;
+        out.position[pixel] = glm::vec3(0.f);
+        out.normal[pixel] = glm::vec3(0.f);
+        p.normalDistance[k][pixel] = kClearViewNoHit;
+      }
+      out.depth[pixel] = tc;
+    }
+    if (p.volumeLayer) p.volumeOut[pixel] = volumeInFront(o, d, box, minOf(tFirst, tf));
     return hits;
+  }
+
+  // §3.2.2: from a context hit (index position idx, outward world normal n) along the inward
+  // normal to the nearest focus surface, as far as maxNormalDistance.
+  VISOPT_HD float distanceToFocus(glm::vec3 idx, glm::vec3 n) const {
+    float dist = kClearViewNoHit;
+    if (!(p.maxNormalDistance > 0.f)) return dist;
+    const glm::vec3 dn = p.volume.directionToIndex(-n);
+    const RayInterval nbox = intersectBox(idx, dn, glm::vec3(p.volume.dims - 1));
+    if (nbox.empty()) return dist;
+    for (int k = 0; k < p.focusCount; ++k) {
+      const float end = minOf(minOf(nbox.t1, p.maxNormalDistance), dist);
+      float tn;
+      if (clearViewFirstHit(p.foci[k], idx, dn, 0.f, end, p.step, tn) && tn < dist) dist = tn;
+    }
+    return dist;
   }
 
   // Emission-absorption of the transfer function's matter over [t0, min(tEnd, t1)]: each step

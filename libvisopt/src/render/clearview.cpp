@@ -73,35 +73,51 @@ ClearViewSurfaceField fieldOf(const ClearViewSurfaceSource& s, DeviceBuffer<uint
 
 }  // namespace
 
+size_t ClearViewContextLayer::bytes() const {
+  return position.bytes() + normal.bytes() + depth.bytes() + normalDistance.bytes();
+}
+
 size_t ClearViewLayers::bytes() const {
+  size_t deeper = 0;
+  for (const ClearViewContextLayer& c : deeperContexts) deeper += c.bytes();
   return contextPosition.bytes() + contextNormal.bytes() + focusPosition.bytes() +
          focusNormal.bytes() + contextDepth.bytes() + focusDepth.bytes() + normalDistance.bytes() +
-         volume.bytes();
+         deeper + volume.bytes();
 }
 
 ClearViewLayersView ClearViewLayers::view() const {
   ClearViewLayersView v;
-  v.contextPosition = contextPosition.data();
-  v.contextNormal = contextNormal.data();
-  v.contextDepth = contextDepth.data();
+  v.contexts[0] = {contextPosition.data(), contextNormal.data(), contextDepth.data(),
+                   normalDistance.data()};
+  for (size_t k = 0; k < deeperContexts.size(); ++k) {
+    const ClearViewContextLayer& c = deeperContexts[k];
+    v.contexts[k + 1] = {c.position.data(), c.normal.data(), c.depth.data(),
+                         c.normalDistance.data()};
+  }
+  v.contextCount = 1 + int(deeperContexts.size());
   v.focusPosition = focusPosition.data();
   v.focusNormal = focusNormal.data();
   v.focusDepth = focusDepth.data();
-  v.normalDistance = normalDistance.data();
   v.volume = volume.size() ? volume.data() : nullptr;
   return v;
 }
 
 void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
                             const Camera& camera, int width, int height,
-                            const ClearViewSurfaceSource& context,
-                            const ClearViewSurfaceSource& focus, bool volumeLayer,
+                            std::span<const ClearViewSurfaceSource> contexts,
+                            std::span<const ClearViewSurfaceSource> foci, bool volumeLayer,
                             ClearViewLayers& out) {
-  if (!context.field || !focus.field)
-    throw Error(ErrorKind::Usage, "ClearView: a layer without a field");
+  if (contexts.empty() || foci.empty() || contexts.size() > size_t(kClearViewMaxLayers) ||
+      foci.size() > size_t(kClearViewMaxLayers))
+    throw Error(ErrorKind::Usage, "ClearView: 1.." + std::to_string(kClearViewMaxLayers) +
+                                      " context and focus layers");
   const GridSpec& grid = volume.grid();
-  if (context.field->grid().dims != grid.dims || focus.field->grid().dims != grid.dims)
-    throw Error(ErrorKind::Usage, "ClearView: the layers' fields must be on the volume's grid");
+  for (const auto* sources : {&contexts, &foci})
+    for (const ClearViewSurfaceSource& s : *sources) {
+      if (!s.field) throw Error(ErrorKind::Usage, "ClearView: a layer without a field");
+      if (s.field->grid().dims != grid.dims)
+        throw Error(ErrorKind::Usage, "ClearView: the layers' fields must be on the volume's grid");
+    }
   const size_t n = size_t(width) * size_t(height);
   if (out.width != width || out.height != height || out.contextDepth.size() != n) {
     out.contextPosition = DeviceBuffer<glm::vec3>(n);
@@ -111,7 +127,16 @@ void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>&
     out.contextDepth = DeviceBuffer<float>(n);
     out.focusDepth = DeviceBuffer<float>(n);
     out.normalDistance = DeviceBuffer<float>(n);
+    out.deeperContexts.clear();
   }
+  out.deeperContexts.resize(contexts.size() - 1);
+  for (ClearViewContextLayer& c : out.deeperContexts)
+    if (c.depth.size() != n) {
+      c.position = DeviceBuffer<glm::vec3>(n);
+      c.normal = DeviceBuffer<glm::vec3>(n);
+      c.depth = DeviceBuffer<float>(n);
+      c.normalDistance = DeviceBuffer<float>(n);
+    }
   if (volumeLayer && out.volume.size() != n) out.volume = DeviceBuffer<glm::vec4>(n);
   if (!volumeLayer) out.volume = DeviceBuffer<glm::vec4>();
   out.width = width;
@@ -120,15 +145,23 @@ void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>&
   ClearViewExtractParams p;
   p.camera = FrustumMap(FrustumGrid::forCamera(camera, width, height, grid.worldBounds(), 1, 1.f));
   p.volume = GridMap(grid);
-  DeviceBuffer<uint8_t> contextEmpty, focusEmpty;
-  p.context = fieldOf(context, contextEmpty);
-  p.focus = fieldOf(focus, focusEmpty);
+  // Each isosurface's empty-space flags, alive until the kernel has run.
+  std::vector<DeviceBuffer<uint8_t>> empty(contexts.size() + foci.size());
+  p.contextCount = int(contexts.size());
+  p.focusCount = int(foci.size());
+  for (size_t k = 0; k < contexts.size(); ++k) p.contexts[k] = fieldOf(contexts[k], empty[k]);
+  for (size_t k = 0; k < foci.size(); ++k) p.foci[k] = fieldOf(foci[k], empty[contexts.size() + k]);
   p.step = 0.5f * grid.minSpacing();
   const glm::vec3 diagonal = grid.worldBounds().hi - grid.worldBounds().lo;
   p.maxNormalDistance = 0.25f * glm::length(diagonal);
-  p.contextOut = {out.contextPosition.data(), out.contextNormal.data(), out.contextDepth.data()};
+  p.contextOut[0] = {out.contextPosition.data(), out.contextNormal.data(), out.contextDepth.data()};
+  p.normalDistance[0] = out.normalDistance.data();
+  for (size_t k = 0; k < out.deeperContexts.size(); ++k) {
+    ClearViewContextLayer& c = out.deeperContexts[k];
+    p.contextOut[k + 1] = {c.position.data(), c.normal.data(), c.depth.data()};
+    p.normalDistance[k + 1] = c.normalDistance.data();
+  }
   p.focusOut = {out.focusPosition.data(), out.focusNormal.data(), out.focusDepth.data()};
-  p.normalDistance = out.normalDistance.data();
   if (volumeLayer) {
     p.volumeLayer = true;
     p.scalars = FieldView(volume.normalized);
@@ -140,6 +173,13 @@ void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>&
                                     [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
   out.contextPixels = hits % ClearViewExtractKernel::kFocusHit;
   out.focusPixels = hits / ClearViewExtractKernel::kFocusHit;
+  for (ClearViewContextLayer& c : out.deeperContexts) {
+    const float* depth = c.depth.data();
+    c.pixels = exec::reduce(
+        "clearview: count hits", int64_t(n), int64_t(0),
+        [=] VISOPT_HD(int64_t i) { return int64_t(depth[i] < kClearViewNoHit ? 1 : 0); },
+        [] VISOPT_HD(int64_t a, int64_t b) { return a + b; });
+  }
 }
 
 namespace {
@@ -221,6 +261,9 @@ void compositeClearView(const ClearViewLayers& layers, const ClearViewSettings& 
     stats->focusPoint = p.focusPoint;
     stats->contextPixels = layers.contextPixels;
     stats->focusPixels = layers.focusPixels;
+    stats->deeperContextPixels.clear();
+    for (const ClearViewContextLayer& c : layers.deeperContexts)
+      stats->deeperContextPixels.push_back(c.pixels);
   }
 }
 

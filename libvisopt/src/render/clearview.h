@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -16,11 +18,22 @@
 
 namespace visopt {
 
-// The layers of one view: one entry per pixel, row 0 at the top.
+// One context surface layer of one view.
+struct ClearViewContextLayer {
+  DeviceBuffer<glm::vec3> position, normal;
+  DeviceBuffer<float> depth, normalDistance;
+  int64_t pixels = 0;  // with a hit
+  size_t bytes() const;
+};
+
+// The layers of one view: one entry per pixel, row 0 at the top. The first context layer's
+// buffers are named (contextPosition ...), the deeper ones follow in deeperContexts; the focus
+// buffers hold the nearest hit of all focus surfaces.
 struct ClearViewLayers {
   int width = 0, height = 0;
   DeviceBuffer<glm::vec3> contextPosition, contextNormal, focusPosition, focusNormal;
   DeviceBuffer<float> contextDepth, focusDepth, normalDistance;
+  std::vector<ClearViewContextLayer> deeperContexts;
   DeviceBuffer<glm::vec4> volume;  // empty without a volume layer
   int64_t contextPixels = 0, focusPixels = 0;
 
@@ -35,13 +48,14 @@ struct ClearViewSurfaceSource {
   float sign = 1.f;
 };
 
-// Extracts the layers of `camera`'s view at width x height. `transfer` (the baked table) is read
-// only with a volume layer. The distance measure looks along the normal as far as a quarter of
-// the volume's diagonal.
+// Extracts the layers of `camera`'s view at width x height: the context surfaces in `contexts`
+// (front to back) and the nearest hit of those in `foci` (1..kClearViewMaxLayers each).
+// `transfer` (the baked table) is read only with a volume layer. The distance measure looks along
+// the normal as far as a quarter of the volume's diagonal.
 void extractClearViewLayers(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
                             const Camera& camera, int width, int height,
-                            const ClearViewSurfaceSource& context,
-                            const ClearViewSurfaceSource& focus, bool volumeLayer,
+                            std::span<const ClearViewSurfaceSource> contexts,
+                            std::span<const ClearViewSurfaceSource> foci, bool volumeLayer,
                             ClearViewLayers& out);
 
 // The focus point C (§3.2): the cursor's pixel projected onto the focus layer; false when the

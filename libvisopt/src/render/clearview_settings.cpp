@@ -55,8 +55,7 @@ bool colour(glm::vec3 c) {
          c.g >= 0.f && c.b >= 0.f;
 }
 
-void checkLayer(const ClearViewLayer& layer, const char* role) {
-  const std::string r = role;
+void checkLayer(const ClearViewLayer& layer, const std::string& r) {
   require(std::isfinite(layer.isovalue), "the " + r + " layer's isovalue must be finite");
   if (layer.kind == ClearViewLayerKind::Importance)
     require(layer.isovalue > 0.0 && layer.isovalue <= 1.0,
@@ -72,6 +71,14 @@ void checkClearViewSettings(const ClearViewSettings& s) {
           "the image size must be 1..16384 pixels per side");
   checkLayer(s.context, "context");
   checkLayer(s.focus, "focus");
+  require(s.deeperContexts.size() < size_t(kClearViewMaxLayers) &&
+              s.moreFoci.size() < size_t(kClearViewMaxLayers),
+          "at most " + std::to_string(kClearViewMaxLayers) + " context and " +
+              std::to_string(kClearViewMaxLayers) + " focus layers");
+  for (size_t i = 0; i < s.deeperContexts.size(); ++i)
+    checkLayer(s.deeperContexts[i], "context " + std::to_string(i + 2));
+  for (size_t i = 0; i < s.moreFoci.size(); ++i)
+    checkLayer(s.moreFoci[i], "focus " + std::to_string(i + 2));
   require(std::isfinite(s.focusPixel.x) && std::isfinite(s.focusPixel.y),
           "the focus pixel must be finite");
   require(std::isfinite(s.size) && s.size >= 0.f, "the hotspot size must be finite, >= 0");

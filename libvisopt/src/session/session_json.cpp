@@ -1,20 +1,21 @@
 // Session <-> JSON text of the current format version (older versions go through migrate()).
 //
-//   {"format": "visopt-session", "version": 4,
+//   {"format": "visopt-session", "version": 5,
 //    "data": {"builtin": "shepp-logan", "resolution": 64}          (or {"volume": REF})
 //    "precision": "fp16", "transferFunction": {...}, "importance": {"kind": "curve", ...},
 //    "contextSurfaces": [{"source": "mesh:...", "file": REF, ...}], "extinction": {...},
 //    "levelSet": {...}, "camera": {...}, "light": {...}, "lens": {...}, "render": {...},
 //    "frozen": true, "worldMask": {"dims": [..], "encoding": "bits-lsb+zstd+base64", ...},
-//    "clearView": {"context": LAYER, "focus": LAYER, "measure": "distance", "size": 12, ...}}
+//    "clearView": {"context": LAYER, "focus": LAYER, "deeperContexts": [LAYER, ...],
+//                  "moreFoci": [LAYER, ...], "measure": "distance", "size": 12, ...}}
 //   REF = {"absolute": "/data/ct.nii.gz", "relative": "../data/ct.nii.gz", "sha256": .., "bytes":
 //   ..}
 //   LAYER = {"kind": "iso", "isovalue": -400} | {"kind": "surface", "surface": 0}
 //         | {"kind": "importance", "isovalue": 0.5}
 // Settings sections hold only values that differ from the defaults and are left out when empty.
-// "clearView" is there when the session has hotspot settings at all; its two layers are always
-// written (their default is the scene's: a context surface, the importance), everything else
-// only where it differs from ClearViewSettings{}.
+// "clearView" is there when the session has hotspot settings at all; its first two layers are
+// always written (their default is the scene's: a context surface, the importance), the further
+// ones when there are any, everything else only where it differs from ClearViewSettings{}.
 #include <nlohmann/json.hpp>
 
 #include "session/json_fields.h"
@@ -155,6 +156,14 @@ constexpr ClearViewShader kShaders[] = {ClearViewShader::Diffuse, ClearViewShade
 OrderedJson clearViewToJson(const ClearViewSettings& c) {
   const ClearViewSettings defaults;
   OrderedJson j = {{"context", layerToJson(c.context)}, {"focus", layerToJson(c.focus)}};
+  for (const auto& [key, layers] : {std::pair<const char*, const std::vector<ClearViewLayer>*>{
+                                        "deeperContexts", &c.deeperContexts},
+                                    {"moreFoci", &c.moreFoci}}) {
+    if (layers->empty()) continue;
+    OrderedJson list = OrderedJson::array();
+    for (const ClearViewLayer& l : *layers) list.push_back(layerToJson(l));
+    j[key] = list;
+  }
   if (c.measure != defaults.measure) j["measure"] = toString(c.measure);
   if (c.contextShader != defaults.contextShader) j["contextShader"] = toString(c.contextShader);
   if (c.focusShader != defaults.focusShader) j["focusShader"] = toString(c.focusShader);
@@ -172,6 +181,17 @@ ClearViewSettings clearViewFromJson(const json& j, const Where& where) {
   };
   c.context = layer("context");
   c.focus = layer("focus");
+  for (const auto& [key, layers] :
+       {std::pair<const char*, std::vector<ClearViewLayer>*>{"deeperContexts", &c.deeperContexts},
+        {"moreFoci", &c.moreFoci}}) {
+    auto it = j.find(key);
+    if (it == j.end()) continue;
+    const Where at = where.key(key);
+    if (!it->is_array()) at.fail("must be a list of layers");
+    if (it->size() >= size_t(kClearViewMaxLayers))
+      at.fail("at most " + std::to_string(kClearViewMaxLayers - 1) + " layers");
+    for (size_t i = 0; i < it->size(); ++i) layers->push_back(layerFromJson((*it)[i], at.index(i)));
+  }
   if (auto it = j.find("measure"); it != j.end())
     c.measure = enumFromJson(*it, kMeasures, where.key("measure"));
   if (auto it = j.find("contextShader"); it != j.end())

@@ -52,10 +52,20 @@ void addClearView(nlohmann::json& doc, const Where&) {
   doc.erase("clearView");
 }
 
+// v4 -> v5: ClearView's further layers ("deeperContexts", "moreFoci" in "clearView"). A
+// version-4 reader ignored them, so in a version-4 file they were never visopt's: dropped.
+void addClearViewLayers(nlohmann::json& doc, const Where&) {
+  auto it = doc.find("clearView");
+  if (it == doc.end() || !it->is_object()) return;
+  it->erase("deeperContexts");
+  it->erase("moreFoci");
+}
+
 }  // namespace
 
 const std::vector<Converter>& converters() {
-  static const std::vector<Converter> list = {&cameraOrbitToFrame, &renameSections, &addClearView};
+  static const std::vector<Converter> list = {&cameraOrbitToFrame, &renameSections, &addClearView,
+                                              &addClearViewLayers};
   return list;
 }
 

@@ -329,11 +329,28 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
       tr("The semi-transparent context surface that the hotspot opens. Default: the scene's "
          "context surface 0, else the data's isosurface at the middle of its range."));
   layersForm->addRow(tr("Context"), context_);
+  deeperOn_ = new QCheckBox(tr("Second context layer, behind the first"), layers);
+  deeperOn_->setObjectName(QStringLiteral("deeperContextOn"));
+  deeperOn_->setToolTip(
+      tr("A further semi-transparent context surface, searched along each ray from where the "
+         "first one was hit (choose one that lies behind it, e.g. the skull behind the skin); "
+         "the hotspot opens both. Default: off."));
+  layersForm->addRow(QString(), deeperOn_);
+  deeper_ = new HotspotLayerEditor(QStringLiteral("deeperContext"), layers);
+  layersForm->addRow(tr("Context 2"), deeper_);
   focus_ = new HotspotLayerEditor(QStringLiteral("focus"), layers);
   focus_->kindBox()->setToolTip(
       tr("The opaque focus surface seen through the hotspot. Default: the importance at 0.5 "
          "when the scene has one, else the data's isosurface at the middle of its range."));
   layersForm->addRow(tr("Focus"), focus_);
+  secondFocusOn_ = new QCheckBox(tr("Second focus layer"), layers);
+  secondFocusOn_->setObjectName(QStringLiteral("secondFocusOn"));
+  secondFocusOn_->setToolTip(
+      tr("A further opaque focus surface; each pixel shows the nearer of the two, and the "
+         "hotspot's centre lies on the nearer one. Default: off."));
+  layersForm->addRow(QString(), secondFocusOn_);
+  secondFocus_ = new HotspotLayerEditor(QStringLiteral("secondFocus"), layers);
+  layersForm->addRow(tr("Focus 2"), secondFocus_);
   volumeLayer_ = new QCheckBox(tr("Volume in front"), layers);
   volumeLayer_->setObjectName(QStringLiteral("volumeLayer"));
   volumeLayer_->setToolTip(
@@ -444,8 +461,14 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
 
   setSettings(ClearViewSettings{});
 
-  connect(context_, &HotspotLayerEditor::edited, this, &HotspotPanel::onEdited);
-  connect(focus_, &HotspotLayerEditor::edited, this, &HotspotPanel::onEdited);
+  for (HotspotLayerEditor* e : {context_, focus_, deeper_, secondFocus_})
+    connect(e, &HotspotLayerEditor::edited, this, &HotspotPanel::onEdited);
+  for (QCheckBox* box : {deeperOn_, secondFocusOn_})
+    connect(box, &QCheckBox::toggled, this, [this] {
+      deeper_->setEnabled(deeperOn_->isChecked());
+      secondFocus_->setEnabled(secondFocusOn_->isChecked());
+      onEdited();
+    });
   for (QComboBox* box : {measure_, contextShader_, focusShader_, light_})
     connect(box, &QComboBox::currentIndexChanged, this, &HotspotPanel::onEdited);
   for (QDoubleSpinBox* box : {size_, weight_, distanceScale_, ambient_})
@@ -459,10 +482,16 @@ HotspotPanel::HotspotPanel(QWidget* parent) : QWidget(parent) {
 void HotspotPanel::setScene(const std::vector<ContextSurfaceSpec>& surfaces, double valueMin,
                             double valueMax, float sceneRadius) {
   updating_ = true;
-  for (HotspotLayerEditor* e : {context_, focus_}) {
+  for (HotspotLayerEditor* e : {context_, focus_, deeper_, secondFocus_}) {
     e->setSurfaces(surfaces);
     e->setValueRange(valueMin, valueMax);
   }
+  // A second layer not in use starts as the data's isosurface three quarters up its range
+  // (denser matter, usually deeper inside), so that switching it on shows something.
+  for (auto [on, editor] : {std::pair{deeperOn_, deeper_}, std::pair{secondFocusOn_, secondFocus_}})
+    if (!on->isChecked())
+      editor->setLayer(
+          {ClearViewLayerKind::Isosurface, valueMin + 0.75 * (valueMax - valueMin), 0});
   const double radius = std::isfinite(sceneRadius) && sceneRadius > 0.f ? sceneRadius : 1.0;
   const double size = size_->value();
   size_->setRange(0.0, std::max(4.0 * radius, size));
@@ -472,14 +501,20 @@ void HotspotPanel::setScene(const std::vector<ContextSurfaceSpec>& surfaces, dou
 }
 
 void HotspotPanel::setHistogram(std::shared_ptr<const Histogram> histogram) {
-  context_->setHistogram(histogram);
-  focus_->setHistogram(std::move(histogram));
+  for (HotspotLayerEditor* e : {context_, focus_, deeper_}) e->setHistogram(histogram);
+  secondFocus_->setHistogram(std::move(histogram));
 }
 
 void HotspotPanel::setSettings(const ClearViewSettings& s) {
   updating_ = true;
   context_->setLayer(s.context);
   focus_->setLayer(s.focus);
+  deeperOn_->setChecked(!s.deeperContexts.empty());
+  if (!s.deeperContexts.empty()) deeper_->setLayer(s.deeperContexts.front());
+  deeper_->setEnabled(!s.deeperContexts.empty());
+  secondFocusOn_->setChecked(!s.moreFoci.empty());
+  if (!s.moreFoci.empty()) secondFocus_->setLayer(s.moreFoci.front());
+  secondFocus_->setEnabled(!s.moreFoci.empty());
   selectData(measure_, int(s.measure));
   selectData(contextShader_, int(s.contextShader));
   selectData(focusShader_, int(s.focusShader));
@@ -499,6 +534,17 @@ ClearViewSettings HotspotPanel::settings() const {
   ClearViewSettings s;
   s.context = context_->layer();
   s.focus = focus_->layer();
+  // The second layers as shown, then any further ones as they were given.
+  auto layers = [](QCheckBox* on, HotspotLayerEditor* editor,
+                   const std::vector<ClearViewLayer>& given) {
+    std::vector<ClearViewLayer> out;
+    if (!on->isChecked()) return out;
+    out.push_back(editor->layer());
+    if (given.size() > 1) out.insert(out.end(), given.begin() + 1, given.end());
+    return out;
+  };
+  s.deeperContexts = layers(deeperOn_, deeper_, colours_.deeperContexts);
+  s.moreFoci = layers(secondFocusOn_, secondFocus_, colours_.moreFoci);
   s.measure = ClearViewMeasure(measure_->currentData().toInt());
   s.contextShader = ClearViewShader(contextShader_->currentData().toInt());
   s.focusShader = ClearViewShader(focusShader_->currentData().toInt());

@@ -1,7 +1,9 @@
 // The Hotspot panel: the ClearView settings (Krüger, Schneider, Westermann 2006;
 // visopt/clearview.h) that the Hotspot tool renders with. The context and the focus layer are
 // each a context surface of the scene, an isosurface of the data (picked on the histogram or
-// typed in data units) or the importance's isosurface; then the measure that keeps the context
+// typed in data units) or the importance's isosurface, and each may have a second one (a context
+// layer behind the first, a focus layer of which the nearer is shown; further ones from a
+// session or the library are kept as they are); then the measure that keeps the context
 // opaque, the two shaders, the hotspot's size, the weights, the border, the light and the volume
 // layer. The panel changes nothing itself: it emits settingsEdited, and shows what it is given
 // (setSettings), the library's complaint about a combination (setProblem) and the statistics
@@ -123,6 +125,11 @@ class HotspotPanel : public QWidget {
 
   HotspotLayerEditor* contextLayer() const { return context_; }
   HotspotLayerEditor* focusLayer() const { return focus_; }
+  // The second context and focus layers and the boxes that switch them on.
+  HotspotLayerEditor* deeperContextLayer() const { return deeper_; }
+  HotspotLayerEditor* secondFocusLayer() const { return secondFocus_; }
+  QCheckBox* deeperContextBox() const { return deeperOn_; }
+  QCheckBox* secondFocusBox() const { return secondFocusOn_; }
 
  signals:
   void settingsEdited(const visopt::ClearViewSettings& settings);
@@ -135,6 +142,10 @@ class HotspotPanel : public QWidget {
   bool updating_ = false;
   HotspotLayerEditor* context_ = nullptr;
   HotspotLayerEditor* focus_ = nullptr;
+  QCheckBox* deeperOn_ = nullptr;
+  HotspotLayerEditor* deeper_ = nullptr;
+  QCheckBox* secondFocusOn_ = nullptr;
+  HotspotLayerEditor* secondFocus_ = nullptr;
   QComboBox* measure_ = nullptr;
   QComboBox* contextShader_ = nullptr;
   QComboBox* focusShader_ = nullptr;
@@ -149,7 +160,9 @@ class HotspotPanel : public QWidget {
   QPushButton* optimiseAround_ = nullptr;
   QLabel* problem_ = nullptr;
   QLabel* stats_ = nullptr;
-  ClearViewSettings colours_;  // the colours, which the panel does not edit, kept as given
+  // The colours and the layers beyond the second of each kind, which the panel does not edit,
+  // kept as given.
+  ClearViewSettings colours_;
 };
 
 }  // namespace visopt::ws

@@ -49,6 +49,58 @@ std::vector<float> valuesOf(const Field3D& f) {
 
 }  // namespace
 
+// The fast coarse-grid correction (rows, per-axis weights, unchanged rows skipped) against the
+// reference (per voxel, world positions sampled twice): random changes confined to a slab of the
+// coarse grid, odd grid sizes (levelGrid's rounding), fp32 and fp16 targets, with clamping.
+TEST(MultigridTransfer, TheFastCorrectionMatchesTheReference) {
+  for (Precision precision : {Precision::FP32, Precision::FP16})
+    for (const glm::ivec3 dims : {glm::ivec3(37, 29, 41), glm::ivec3(64, 64, 64)}) {
+      GridSpec fine;
+      fine.dims = dims;
+      fine.spacing = glm::vec3(0.8f, 1.1f, 0.9f);
+      fine.origin = glm::vec3(-3.f, 2.f, 5.f);
+      const GridSpec coarse = levelGrid(fine, 4);
+      Field3D before("before", coarse, Precision::FP32), now("now", coarse, Precision::FP32);
+      uint32_t seed = 12345u;
+      auto next = [&] {
+        seed = seed * 1664525u + 1013904223u;
+        return float(seed >> 8) / float(1u << 24);
+      };
+      for (int k = 0; k < coarse.dims.z; ++k)
+        for (int j = 0; j < coarse.dims.y; ++j)
+          for (int i = 0; i < coarse.dims.x; ++i) {
+            const size_t c = coarse.linearIndex(i, j, k);
+            const float b = next();
+            before.set(c, b);
+            // Changes only in a slab of coarse rows, so that whole fine rows are skipped.
+            now.set(c, k >= 3 && k <= 6 ? b + 0.4f * (next() - 0.5f) : b);
+          }
+      Field3D fast("fast", fine, precision), reference("reference", fine, precision);
+      for (size_t v = 0; v < fine.voxelCount(); ++v) {
+        // Within [lo, hi], as mu is: a voxel outside would be clamped by the smallest change, and
+        // where the reference's change rounds to exactly 0 and the fast one's to 1e-8 they differ.
+        const float x = 0.5f + 0.25f * std::sin(0.37f * float(v));
+        fast.set(v, x);
+        reference.set(v, x);
+      }
+      const std::vector<float> initial = valuesOf(reference);
+      const double mostFast = prolongChange(now, before, GridMap(coarse), fast, 0.2f, 0.8f);
+      const double mostRef =
+          prolongChangeReference(now, before, GridMap(coarse), reference, 0.2f, 0.8f);
+      const float tolerance = precision == Precision::FP16 ? 1e-3f : 1e-5f;
+      float worst = 0.f;
+      size_t changed = 0;
+      for (size_t v = 0; v < fine.voxelCount(); ++v) {
+        worst = std::max(worst, std::abs(fast.get(v) - reference.get(v)));
+        changed += reference.get(v) != initial[v];
+      }
+      EXPECT_LT(worst, tolerance) << toString(precision) << " " << dims.x;
+      EXPECT_NEAR(mostFast, mostRef, tolerance);
+      EXPECT_GT(changed, fine.voxelCount() / 10);     // the slab moved voxels,
+      EXPECT_LT(changed, fine.voxelCount() * 2 / 3);  // but not all of them
+    }
+}
+
 // The restriction samples of an interior coarse voxel lie symmetrically about its centre, so
 // their mean of a linear field is the field at the centre and their maximum the uphill corner's
 // value; trilinear prolongation reproduces a linear change exactly.

@@ -127,8 +127,8 @@ void restrictBaseAndImportance(const Field3D& scalarField, const DeviceBuffer<gl
   });
 }
 
-double prolongChange(const Field3D& now, const Field3D& before, const GridMap& coarse,
-                     Field3D& fine, float lo, float hi) {
+double prolongChangeReference(const Field3D& now, const Field3D& before, const GridMap& coarse,
+                              Field3D& fine, float lo, float hi) {
   const FieldView a(now), b(before), out(fine);
   const GridMap map(fine.grid());
   return exec::reduce(
@@ -142,6 +142,101 @@ double prolongChange(const Field3D& now, const Field3D& before, const GridMap& c
         const float next = fminf(fmaxf(old + change, lo), hi);
         out.store(size_t(v), next);
         return double(fabsf(next - old));
+      },
+      [] VISOPT_HD(double x, double y) { return x > y ? x : y; });
+}
+
+namespace {
+
+// The trilinear weights along one axis at coarse index q, clamped to the grid as
+// FieldView::sample does.
+struct AxisWeights {
+  int i0, i1;
+  float f;
+};
+VISOPT_HD VISOPT_INLINE AxisWeights axisWeights(float q, int n) {
+  q = q > 0.f ? (q < float(n - 1) ? q : float(n - 1)) : 0.f;  // no libm call in the loop
+  AxisWeights a;
+  a.i0 = int(q);
+  a.i1 = a.i0 + 1 < n ? a.i0 + 1 : n - 1;
+  a.f = q - float(a.i0);
+  return a;
+}
+
+}  // namespace
+
+double prolongChange(const Field3D& now, const Field3D& before, const GridMap& coarse,
+                     Field3D& fine, float lo, float hi) {
+  const GridMap map(fine.grid());
+  // fine voxel (i, j, k) -> coarse index q0 + (i ax, j ay, k az) when the axes map onto axes.
+  const glm::vec3 q0 = coarse.toIndex(map.toWorld(glm::vec3(0.f)));
+  const glm::vec3 ax = coarse.toIndex(map.toWorld(glm::vec3(1.f, 0.f, 0.f))) - q0;
+  const glm::vec3 ay = coarse.toIndex(map.toWorld(glm::vec3(0.f, 1.f, 0.f))) - q0;
+  const glm::vec3 az = coarse.toIndex(map.toWorld(glm::vec3(0.f, 0.f, 1.f))) - q0;
+  const float off =
+      fabsf(ax.y) + fabsf(ax.z) + fabsf(ay.x) + fabsf(ay.z) + fabsf(az.x) + fabsf(az.y);
+  if (!(off < 1e-5f) || now.grid().dims != coarse.dims || before.grid().dims != coarse.dims)
+    return prolongChangeReference(now, before, coarse, fine, lo, hi);
+
+  const glm::ivec3 cd = coarse.dims, fd = map.dims;
+  const int64_t coarseCount = int64_t(cd.x) * cd.y * cd.z;
+  DeviceBuffer<float> diff(static_cast<size_t>(coarseCount));
+  DeviceBuffer<uint8_t> rowChanged(static_cast<size_t>(int64_t(cd.y) * cd.z));
+  {
+    const FieldView a(now), b(before);
+    float* d = diff.data();
+    uint8_t* changed = rowChanged.data();
+    exec::parallelFor("multigrid correction: coarse change", int64_t(cd.y) * cd.z,
+                      [=] VISOPT_HD(int64_t row) {
+                        uint8_t any = 0;
+                        for (int i = 0; i < cd.x; ++i) {
+                          const size_t c = size_t(row * cd.x + i);
+                          const float v = a.load(c) - b.load(c);
+                          d[c] = v;
+                          any |= v != 0.f ? 1 : 0;
+                        }
+                        changed[row] = any;
+                      });
+  }
+  // The x weights are the same in every row.
+  DeviceBuffer<AxisWeights> xWeights(static_cast<size_t>(fd.x));
+  for (int i = 0; i < fd.x; ++i) xWeights[size_t(i)] = axisWeights(q0.x + float(i) * ax.x, cd.x);
+  const AxisWeights* xw = xWeights.data();
+  const FieldView out(fine);
+  const float* d = diff.data();
+  const uint8_t* changed = rowChanged.data();
+  return exec::reduce(
+      "multigrid correction: fine rows", int64_t(fd.y) * fd.z, 0.0,
+      [=] VISOPT_HD(int64_t row) {
+        const int j = int(row % fd.y), k = int(row / fd.y);
+        const AxisWeights y = axisWeights(q0.y + float(j) * ay.y, cd.y);
+        const AxisWeights z = axisWeights(q0.z + float(k) * az.z, cd.z);
+        const int64_t r00 = int64_t(z.i0) * cd.y + y.i0, r10 = int64_t(z.i0) * cd.y + y.i1;
+        const int64_t r01 = int64_t(z.i1) * cd.y + y.i0, r11 = int64_t(z.i1) * cd.y + y.i1;
+        if (!(changed[r00] | changed[r10] | changed[r01] | changed[r11])) return 0.0;
+        const float* c00 = d + r00 * cd.x;
+        const float* c10 = d + r10 * cd.x;
+        const float* c01 = d + r01 * cd.x;
+        const float* c11 = d + r11 * cd.x;
+        double most = 0.0;
+        const size_t base = size_t(row) * size_t(fd.x);
+        for (int i = 0; i < fd.x; ++i) {
+          const AxisWeights x = xw[i];
+          const float e00 = c00[x.i0] + x.f * (c00[x.i1] - c00[x.i0]);
+          const float e10 = c10[x.i0] + x.f * (c10[x.i1] - c10[x.i0]);
+          const float e01 = c01[x.i0] + x.f * (c01[x.i1] - c01[x.i0]);
+          const float e11 = c11[x.i0] + x.f * (c11[x.i1] - c11[x.i0]);
+          const float e0 = e00 + y.f * (e10 - e00), e1 = e01 + y.f * (e11 - e01);
+          const float change = e0 + z.f * (e1 - e0);
+          if (change == 0.f) continue;
+          const float old = out.load(base + size_t(i));
+          const float sum = old + change;
+          const float next = sum > lo ? (sum < hi ? sum : hi) : lo;
+          out.store(base + size_t(i), next);
+          const double moved = double(fabsf(next - old));
+          most = moved > most ? moved : most;
+        }
+        return most;
       },
       [] VISOPT_HD(double x, double y) { return x > y ? x : y; });
 }

@@ -48,7 +48,15 @@ void restrictBaseAndImportance(const Field3D& scalars, const DeviceBuffer<glm::v
                                Field3D& baseCoarse, Field3D& importanceCoarse);
 // The coarse-grid correction: fine += the trilinear prolongation of (now - before), both on the
 // grid `coarse`, clamped to [lo, hi]. Returns the largest |change| applied.
+// The fast path: the difference taken once on the coarse grid (fp32), the fine voxels visited by
+// rows with the coarse index along each axis from one multiply-add, and rows whose four coarse
+// rows carry no change skipped (a followed camera changes mu and phi only where the view
+// moved). Grids whose axes do not map onto each other's axes (never, for levelGrid's) take the
+// reference path.
 double prolongChange(const Field3D& now, const Field3D& before, const GridMap& coarse,
                      Field3D& fine, float lo, float hi);
+// The reference: per fine voxel, its world position sampled in `now` and in `before`.
+double prolongChangeReference(const Field3D& now, const Field3D& before, const GridMap& coarse,
+                              Field3D& fine, float lo, float hi);
 
 }  // namespace visopt

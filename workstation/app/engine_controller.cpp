@@ -29,6 +29,10 @@ constexpr int kFrameIntervalMs = 400;
 // level (test_camera_follow; the probe reports what a drag costs).
 constexpr int kFollowIterationsPerCall = 4;
 constexpr int kFollowCallsPerCamera = 8;
+// In a continuous drag, a follow call after a preview only when the last one ended at least this
+// long ago: about every other preview, so that previews keep coming at ~10 per second (a preview
+// is ~60 ms, a follow call ~12 ms on the default scene; docs/optimization-benchmarks.md).
+constexpr auto kFollowSpacingInDrag = std::chrono::milliseconds(100);
 // Longest side of the image the optimisation's frustum grids are sized for while following the
 // camera: 128 view rays per side (frustumScale 0.5), about one per voxel column of a 128^3 scene.
 constexpr int kOptimizationSide = 256;
@@ -455,7 +459,11 @@ void EngineController::workerLoop() {
       // A mouse in motion sends a newer camera before each preview is done: one call of
       // following per preview even then (a few ms; the next preview shows what it opened), or a
       // continuous drag would never follow.
-      if (running_ && followWhileDragging_ && !clearViewOn) followOnce(engine);
+      if (running_ && followWhileDragging_ && !clearViewOn &&
+          std::chrono::steady_clock::now() - lastFollowInDrag_ >= kFollowSpacingInDrag) {
+        followOnce(engine);
+        lastFollowInDrag_ = std::chrono::steady_clock::now();
+      }
       continue;
     }
     if (cameraChanged) {

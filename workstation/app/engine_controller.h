@@ -9,6 +9,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -187,6 +188,8 @@ class EngineController : public QObject {
   // renewed at every camera change of a drag, so that a pause in the drag converges on the
   // coarse level and then rests.
   int followCallsLeft_ = 0;
+  // Worker-only: when the last follow call after a drag's preview ended.
+  std::chrono::steady_clock::time_point lastFollowInDrag_{};
   bool restartPending_ = true;  // next optimisation step runs the multigrid schedule
   int itersSinceFrame_ = 0;
   // Worker-only: convergence while following the camera.

@@ -71,40 +71,43 @@ void prolongDeviation(const Field3D& phiCoarse, const Field3D& baseCoarse, const
 // Restriction of an SDF to a coarser grid: the minimum over 3^3 points spread over each coarse
 // voxel, so a surface thinner than a coarse voxel (a skull, a thin shell) does not vanish from
 // the coarse levels, where it would otherwise let the view through.
-void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
+namespace {
+
+// The three restrictions differ only in how they reduce the 27 samples of a coarse voxel.
+enum class Reduction { Min, Mean, Max };
+
+template <Reduction R>
+void restrictBy(const char* name, const Field3D& src, const GridMap& srcMap, Field3D& dst) {
   const FieldView from(src), to(dst);
   const GridMap map(dst.grid());
-  exec::parallelFor("multigrid restrict sdf", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
+  exec::parallelFor(name, int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
     const auto [i, j, k] = map.ijk(v);
-    float m = 3.0e38f;
-    for (int c = 0; c < kRestrictionSamples; ++c)
-      m = fminf(m, from.sample(srcMap.toIndex(restrictionSample(map, i, j, k, c))));
-    to.store(size_t(v), m);
+    float acc = R == Reduction::Min ? 3.0e38f : (R == Reduction::Max ? -3.0e38f : 0.f);
+    for (int c = 0; c < kRestrictionSamples; ++c) {
+      const float s = from.sample(srcMap.toIndex(restrictionSample(map, i, j, k, c)));
+      if constexpr (R == Reduction::Min)
+        acc = fminf(acc, s);
+      else if constexpr (R == Reduction::Max)
+        acc = fmaxf(acc, s);
+      else
+        acc += s;
+    }
+    to.store(size_t(v), R == Reduction::Mean ? acc / float(kRestrictionSamples) : acc);
   });
+}
+
+}  // namespace
+
+void restrictSdf(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
+  restrictBy<Reduction::Min>("multigrid restrict sdf", src, srcMap, dst);
 }
 
 void restrictMean(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
-  const FieldView from(src), to(dst);
-  const GridMap map(dst.grid());
-  exec::parallelFor("multigrid restrict mean", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
-    const auto [i, j, k] = map.ijk(v);
-    float sum = 0.f;
-    for (int c = 0; c < kRestrictionSamples; ++c)
-      sum += from.sample(srcMap.toIndex(restrictionSample(map, i, j, k, c)));
-    to.store(size_t(v), sum / float(kRestrictionSamples));
-  });
+  restrictBy<Reduction::Mean>("multigrid restrict mean", src, srcMap, dst);
 }
 
 void restrictMax(const Field3D& src, const GridMap& srcMap, Field3D& dst) {
-  const FieldView from(src), to(dst);
-  const GridMap map(dst.grid());
-  exec::parallelFor("multigrid restrict max", int64_t(dst.size()), [=] VISOPT_HD(int64_t v) {
-    const auto [i, j, k] = map.ijk(v);
-    float m = -3.0e38f;
-    for (int c = 0; c < kRestrictionSamples; ++c)
-      m = fmaxf(m, from.sample(srcMap.toIndex(restrictionSample(map, i, j, k, c))));
-    to.store(size_t(v), m);
-  });
+  restrictBy<Reduction::Max>("multigrid restrict max", src, srcMap, dst);
 }
 
 void restrictBaseAndImportance(const Field3D& scalarField, const DeviceBuffer<glm::vec4>& table,

@@ -190,9 +190,9 @@ TEST(CliClearView, LayersMustExistInTheScene) {
   const std::string out = tmp("layers.png");
   // shepp-logan has one context surface.
   expectRefused(kShepp, out, "context=surface:3", "context=surface:3");
-  // occluded-blob has no context surface: the default context must be given.
+  // wall-and-membrane has no context surface: the default context must be given.
   const std::string blob =
-      "render --scene builtin:occluded-blob --resolution 24 --size 32x32 --out ";
+      "render --scene builtin:wall-and-membrane --resolution 24 --size 32x32 --out ";
   expectRefused(blob, out, "size=10", "context=iso:VALUE");
   expectRefused(blob, out, "context=surface:0", "no context surface");
   // A volume file has neither a context surface nor an importance (--json: no load progress).

@@ -90,7 +90,7 @@ TEST(OptimizedExtinctionRender, UnchangedExtinctionDrawsAsBefore) {
 
 TEST(OptimizedExtinctionRender, ChangedExtinctionChangesThePicture) {
   Engine e;
-  e.loadBuiltinScene("occluded-blob", 48, /*contextSurfaces=*/false);
+  e.loadBuiltinScene("wall-and-membrane", 48, /*contextSurfaces=*/false);
   e.setViewportSize(kSize, kSize);
   ExtinctionSettings s;
   s.maxIterationsPerLevel = 20;

@@ -11,6 +11,6 @@ BuiltinScene makeEarthMantle(int resolution, Precision precision, MemoryLedger* 
 BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeHydrogen(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeCtHead(int resolution, Precision precision, MemoryLedger* ledger);
-BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger* ledger);
+BuiltinScene makeWallAndMembrane(int resolution, Precision precision, MemoryLedger* ledger);
 
 }  // namespace visopt::scenes

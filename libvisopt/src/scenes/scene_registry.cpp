@@ -36,11 +36,18 @@ const Entry kScenes[] = {
     {"ct-head",
      "CT-like head: the skin isosurface hides a thick skull (marked important) under soft tissue",
      &scenes::makeCtHead},
-    {"occluded-blob",
-     "Himmler & Günther 2026, Fig. 3: a dense wall hides an optically thin important disc behind "
-     "it",
-     &scenes::makeOccludedBlob},
+    {"wall-and-membrane",
+     "A dense wall hides an optically thin important disc behind it (volume only, no context "
+     "surface)",
+     &scenes::makeWallAndMembrane},
 };
+
+// Former names, still accepted (sessions and scripts that use them), not listed.
+struct Alias {
+  const char* old;
+  const char* name;
+};
+const Alias kAliases[] = {{"occluded-blob", "wall-and-membrane"}};
 
 }  // namespace
 
@@ -56,6 +63,8 @@ std::string defaultSceneName() {
 
 BuiltinScene makeBuiltinScene(const std::string& name, int resolution, Precision precision,
                               MemoryLedger* ledger) {
+  for (const Alias& a : kAliases)
+    if (name == a.old) return makeBuiltinScene(a.name, resolution, precision, ledger);
   for (const Entry& e : kScenes)
     if (name == e.name) {
       scenes::checkResolution(name, resolution);

@@ -1,6 +1,8 @@
-// The core scenario of Himmler & Günther 2026 (Fig. 3) in volume form: a dense wall of unimportant
-// matter stands between the camera and an optically thin important disc (a "membrane"), which it
-// hides completely at first.
+// Volume occlusion without a surface ("wall-and-membrane", called "occluded-blob" until
+// 2026-12-04): a dense wall of unimportant matter stands between the camera and an optically thin
+// important disc (a "membrane"), which it hides completely at first; what the extinction
+// optimisation of Himmler & Günther's predecessor [9] opens. It is not paper 000's Fig. 3, whose
+// cases are about a context surface.
 //
 // Why a thin disc: the energy rewards g mu T_V (Eq. 12), so inside an important structure the
 // optimisation raises mu towards mu_max, and a thick structure then shades its own back; its
@@ -38,8 +40,8 @@ float boxDistance(glm::vec3 p, glm::vec3 centre, glm::vec3 h) {
 
 }  // namespace
 
-BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger* ledger) {
-  checkResolution("occluded-blob", resolution);
+BuiltinScene makeWallAndMembrane(int resolution, Precision precision, MemoryLedger* ledger) {
+  checkResolution("wall-and-membrane", resolution);
   const GridSpec grid = sceneGrid(resolution);
   const float w = edgeHalfWidth(grid);  // one voxel
   const glm::vec3 wallCentre(0.f, 0.5f * (kWallY0 + kWallY1), 0.f);
@@ -58,7 +60,7 @@ BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger*
 
   BuiltinScene scene;
   scene.volume =
-      generateVolume("occluded-blob", grid, precision, ledger, 0.0, 1.0, [=](glm::vec3 p) {
+      generateVolume("wall-and-membrane", grid, precision, ledger, 0.0, 1.0, [=](glm::vec3 p) {
         return kWallValue * softInside(boxDistance(p, wallCentre, wallHalf), w) +
                kDiscValue * softInside(disc.distance(p), discEdge);
       });
@@ -68,7 +70,7 @@ BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger*
       grid, precision, ledger, [=](glm::vec3 p) { return softInside(disc.distance(p), discEdge); });
 
   TransferFunction& tf = scene.transferFunction;
-  tf.name = "occluded-blob";
+  tf.name = "wall-and-membrane";
   tf.unitDistance = 10.f;  // mm: an opacity is what 10 mm of the material absorbs
   // The wall: mu = 0.06 / mm (alpha 0.451 per 10 mm), 60 mm deep: transmittance e^-3.6 = 0.027.
   // The disc: mu_bar = 0.005 / mm (alpha 0.049 per 10 mm), faint on its own.
@@ -79,7 +81,7 @@ BuiltinScene makeOccludedBlob(int resolution, Precision precision, MemoryLedger*
               {0.5, {0.95f, 0.35f, 0.15f}},
               {0.8, {0.70f, 0.75f, 0.80f}},
               {1.0, {0.70f, 0.75f, 0.80f}}};
-  tf.validate("scene occluded-blob");
+  tf.validate("scene wall-and-membrane");
   // No context surface: this is the volume form of the scenario. The level-set flow of Eq. 23
   // moves a surface by its curvature (F = -ghat kappa) and by grad ghat . grad phi, both zero on
   // the flat faces of a wall, so the wall as a surface would never open in front of the disc.

@@ -1,4 +1,5 @@
-// The built-in scene "occluded-blob" (Himmler & Günther 2026, Fig. 3 in volume form): with the
+// The built-in scene "wall-and-membrane" (volume occlusion without a surface; "occluded-blob" until
+// 2026-12-04, still accepted): with the
 // default extinction settings the important disc behind the dense wall goes from hidden (V < 0.1)
 // to visible (V > 0.8), the energy falls, and the wall away from every line of sight to the disc
 // keeps mu_bar. Through the Engine API and through `visopt optimize --json`.
@@ -24,7 +25,7 @@ using namespace visopt;
 namespace {
 
 // The scene's geometry (normalised coordinates: world / 100 mm), as documented in
-// src/scenes/occluded_blob.cpp: the wall spans y in [-0.65, -0.05], |x|, |z| <= 0.8; the disc
+// src/scenes/wall_and_membrane.cpp: the wall spans y in [-0.65, -0.05], |x|, |z| <= 0.8; the disc
 // (radius 0.4) lies at y ~ 0.3; the camera looks along +y from 2.8 bounding radii.
 constexpr float kWallY0 = -0.65f, kWallY1 = -0.05f, kWallHalfWidth = 0.8f;
 constexpr float kDiscRadius = 0.4f;
@@ -33,11 +34,11 @@ constexpr int kResolution = 64;
 
 }  // namespace
 
-TEST(OccludedBlobScene, IsListedAndMarksOnlyTheDisc) {
+TEST(WallAndMembraneScene, IsListedAndMarksOnlyTheDisc) {
   bool listed = false;
-  for (const auto& s : builtinScenes()) listed = listed || s.name == "occluded-blob";
+  for (const auto& s : builtinScenes()) listed = listed || s.name == "wall-and-membrane";
   EXPECT_TRUE(listed);
-  const BuiltinScene scene = makeBuiltinScene("occluded-blob", kResolution, Precision::FP32);
+  const BuiltinScene scene = makeBuiltinScene("wall-and-membrane", kResolution, Precision::FP32);
   EXPECT_TRUE(scene.contextSurfaces.empty()) << "the volume form: `optimize` needs no flags";
   // The importance marks the disc only: nothing in the wall.
   const GridSpec& g = scene.importance.grid();
@@ -59,9 +60,9 @@ TEST(OccludedBlobScene, IsListedAndMarksOnlyTheDisc) {
   EXPECT_GT(marked, 300u);
 }
 
-TEST(OccludedBlobScene, TheDiscBecomesVisibleAndTheRestOfTheWallStays) {
+TEST(WallAndMembraneScene, TheDiscBecomesVisibleAndTheRestOfTheWallStays) {
   Engine e;
-  e.loadBuiltinScene("occluded-blob", kResolution, /*contextSurfaces=*/false);
+  e.loadBuiltinScene("wall-and-membrane", kResolution, /*contextSurfaces=*/false);
   e.setViewportSize(96, 96);
   // The default extinction settings: the scene needs no tuning.
   e.setExtinctionSettings(ExtinctionSettings{});
@@ -116,14 +117,26 @@ TEST(OccludedBlobScene, TheDiscBecomesVisibleAndTheRestOfTheWallStays) {
 
 namespace {
 visopt::testing::CliResult runCli(const std::string& args) {
-  return visopt::testing::runCli(args, "occluded-blob");
+  return visopt::testing::runCli(args, "wall-and-membrane");
 }
 }  // namespace
 
-TEST(OccludedBlobScene, CliOptimizeShowsTheDiscComingIntoView) {
+// The former name loads the same scene, recorded under the new name (what sessions store), and
+// is not listed.
+TEST(WallAndMembraneScene, TheFormerNameStillLoadsIt) {
+  const BuiltinScene now = makeBuiltinScene("wall-and-membrane", 24, Precision::FP32);
+  const BuiltinScene old = makeBuiltinScene("occluded-blob", 24, Precision::FP32);
+  ASSERT_EQ(old.volume.normalized.size(), now.volume.normalized.size());
+  for (size_t v = 0; v < now.volume.normalized.size(); ++v)
+    ASSERT_EQ(old.volume.normalized.get(v), now.volume.normalized.get(v));
+  EXPECT_EQ(old.volume.sourcePath, "builtin:wall-and-membrane");
+  for (const auto& s : builtinScenes()) EXPECT_NE(s.name, "occluded-blob");
+}
+
+TEST(WallAndMembraneScene, CliOptimizeShowsTheDiscComingIntoView) {
   const visopt::testing::CliResult r =
-      runCli("optimize --scene builtin:occluded-blob --resolution " + std::to_string(kResolution) +
-             " --size 96x96 --json");
+      runCli("optimize --scene builtin:wall-and-membrane --resolution " +
+             std::to_string(kResolution) + " --size 96x96 --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_GT(j["iterations"].size(), 10u);

@@ -526,7 +526,7 @@ void HotspotPanel::setSettings(const ClearViewSettings& s) {
   showExact(ambient_, double(s.ambient));
   light_->setCurrentIndex(s.headlight ? 0 : 1);
   volumeLayer_->setChecked(s.volumeLayer);
-  colours_ = s;
+  given_ = s;
   updating_ = false;
 }
 
@@ -543,8 +543,8 @@ ClearViewSettings HotspotPanel::settings() const {
     if (given.size() > 1) out.insert(out.end(), given.begin() + 1, given.end());
     return out;
   };
-  s.deeperContexts = layers(deeperOn_, deeper_, colours_.deeperContexts);
-  s.moreFoci = layers(secondFocusOn_, secondFocus_, colours_.moreFoci);
+  s.deeperContexts = layers(deeperOn_, deeper_, given_.deeperContexts);
+  s.moreFoci = layers(secondFocusOn_, secondFocus_, given_.moreFoci);
   s.measure = ClearViewMeasure(measure_->currentData().toInt());
   s.contextShader = ClearViewShader(contextShader_->currentData().toInt());
   s.focusShader = ClearViewShader(focusShader_->currentData().toInt());
@@ -555,9 +555,9 @@ ClearViewSettings HotspotPanel::settings() const {
   s.ambient = float(exactValue(ambient_));
   s.headlight = light_->currentData().toBool();
   s.volumeLayer = volumeLayer_->isChecked();
-  s.contextColor = colours_.contextColor;
-  s.focusColor = colours_.focusColor;
-  s.background = colours_.background;
+  s.contextColor = given_.contextColor;
+  s.focusColor = given_.focusColor;
+  s.background = given_.background;
   return s;
 }
 

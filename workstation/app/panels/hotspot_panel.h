@@ -162,7 +162,7 @@ class HotspotPanel : public QWidget {
   QLabel* stats_ = nullptr;
   // The colours and the layers beyond the second of each kind, which the panel does not edit,
   // kept as given.
-  ClearViewSettings colours_;
+  ClearViewSettings given_;
 };
 
 }  // namespace visopt::ws

@@ -12,5 +12,6 @@ BuiltinScene makeMixer(int resolution, Precision precision, MemoryLedger* ledger
 BuiltinScene makeHydrogen(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeCtHead(int resolution, Precision precision, MemoryLedger* ledger);
 BuiltinScene makeWallAndMembrane(int resolution, Precision precision, MemoryLedger* ledger);
+BuiltinScene makeLevelSetCases(int resolution, Precision precision, MemoryLedger* ledger);
 
 }  // namespace visopt::scenes

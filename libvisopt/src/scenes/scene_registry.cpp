@@ -40,6 +40,10 @@ const Entry kScenes[] = {
      "A dense wall hides an optically thin important disc behind it (volume only, no context "
      "surface)",
      &scenes::makeWallAndMembrane},
+    {"level-set-cases",
+     "Paper 000's Fig. 3: an important object in front of, nested inside and behind a context "
+     "surface",
+     &scenes::makeLevelSetCases},
 };
 
 // Former names, still accepted (sessions and scripts that use them), not listed.

@@ -76,7 +76,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     float reach = kLevelSet.reach;
     float band = kLevelSet.band;
     std::string integrator = kLevelSet.semiImplicit ? "semi-implicit" : "explicit";
-    bool filled = false, deviationView = false;
+    bool filled = false, deviationView = false, noAo = false;
     int resolution = 128, levels = kExtinction.levels,
         iterations = kExtinction.maxIterationsPerLevel;
     float rho = kExtinction.rho, q = kExtinction.q, r = kExtinction.r,
@@ -146,6 +146,8 @@ Runner addOptimizeCommand(CLI::App& app) {
                "Colour surfaces by how far they moved from their base (|phi0| in voxels)");
   app.add_option("--deviation-colormap", o->deviationColormap,
                  "Colormap of the deviation view: viridis, magma, inferno, coolwarm or grey");
+  app.add_flag("--no-ambient-occlusion", o->noAo,
+               "Render the images with the ambient light unoccluded (volume samples and surfaces)");
   app.add_option("--precision", o->precision, "Field storage: fp32 or fp16");
   app.add_option("--size", o->size, "Image size WxH (the frustum grids follow it)");
   app.add_option("--out", o->out,
@@ -285,6 +287,7 @@ Runner addOptimizeCommand(CLI::App& app) {
     rs.height = size.y;
     rs.deviationView = o->deviationView;
     rs.deviationColormap = deviationColormap;
+    rs.ambientOcclusion = !o->noAo;
     nlohmann::json images = nlohmann::json::object();
     if (!o->out.empty()) {
       writePng(engine.render(rs), beforePath(o->out));

@@ -23,7 +23,8 @@ Runner addRenderCommand(CLI::App& app) {
     std::string clearview;
     int resolution = 128;
     float step = RenderSettings{}.stepFactor;  // the library's default
-    bool deviationView = false, preview = false, json = false, noJitter = false;
+    float aoRadius = RenderSettings{}.ambientOcclusionRadius;
+    bool deviationView = false, preview = false, json = false, noJitter = false, noAo = false;
   };
   auto o = std::make_shared<Options>();
   CLI::Option* volumeOption = app.add_option(
@@ -52,6 +53,10 @@ Runner addRenderCommand(CLI::App& app) {
                  "Colormap of the deviation view: viridis, magma, inferno, coolwarm or grey");
   app.add_flag("--preview", o->preview, "Low-resolution preview (1/4 size, double step)");
   app.add_flag("--no-jitter", o->noJitter, "Sample at segment midpoints (shows wood grain)");
+  app.add_flag("--no-ambient-occlusion", o->noAo,
+               "Leave the ambient light unoccluded (volume samples and surfaces)");
+  app.add_option("--ambient-occlusion-radius", o->aoRadius,
+                 "Ambient occlusion radius in voxels (smallest spacing)");
   app.add_option("--out", o->out, "Output PNG")->required();
   app.add_flag("--json", o->json, "Print per-stage times and the memory ledger as JSON");
   app.add_option("--clearview", o->clearview,
@@ -66,7 +71,8 @@ Runner addRenderCommand(CLI::App& app) {
     if (clearview) {
       // ClearView has its own layers and shaders: the ray caster's options would do nothing.
       for (const char* other :
-           {"--deviation-view", "--preview", "--deviation-colormap", "--step", "--no-jitter"})
+           {"--deviation-view", "--preview", "--deviation-colormap", "--step", "--no-jitter",
+            "--no-ambient-occlusion", "--ambient-occlusion-radius"})
         if (given(other))
           throw Error(ErrorKind::Usage, std::string("--clearview and ") + other +
                                             " cannot be combined (the ClearView render has "
@@ -119,6 +125,9 @@ Runner addRenderCommand(CLI::App& app) {
     if (!session || given("--deviation-colormap"))
       settings.deviationColormap = parseColormap(o->deviationColormap);
     if (!session || o->noJitter) settings.jitter = !o->noJitter;
+    if (!session || o->noAo) settings.ambientOcclusion = !o->noAo;
+    if (!session || given("--ambient-occlusion-radius"))
+      settings.ambientOcclusionRadius = o->aoRadius;
     if (clearview) {
       // After the scene, the camera and the size: the layers' defaults follow the scene.
       // A session's hotspot settings (the workstation's Hotspot panel) are the defaults here.
@@ -214,6 +223,7 @@ Runner addRenderCommand(CLI::App& app) {
           {"times_ms",
            {{"load", loadMs},
             {"light_transmittance", stats.lightMilliseconds},
+            {"volume_occlusion", stats.occlusionMilliseconds},
             {"render", stats.milliseconds},
             {"write_png", writeMs},
             {"total", msSince(t0)}}},

@@ -58,6 +58,8 @@ struct RenderSettings {
 
   // Context surfaces (Himmler & Günther 2026, Eq. 8 and §III-E): shaded with normalised
   // Blinn-Phong, shadowed through T_L, darkened by ambient occlusion from the volume and the SDF.
+  // Ambient occlusion (R4, Fig. 6) also darkens the ambient light of the volume's samples: the
+  // mean transmittance of six axis rays of ambientOcclusionRadius from each voxel.
   float surfaceSpecular = 0.3f, surfaceShininess = 32.f;
   bool ambientOcclusion = true;
   float ambientOcclusionRadius = 6.f;  // in voxels
@@ -85,8 +87,11 @@ void checkRenderSettings(const RenderSettings& settings);
 struct RenderStats {
   double milliseconds = 0.0;
   double lightMilliseconds = 0.0;  // T_L update, when it ran
-  int64_t samples = 0;             // volume samples taken
-  int width = 0, height = 0;       // actual rendered resolution (smaller in preview)
+  // The volume's ambient occlusion field, when it was recomputed (Engine::render; it is kept
+  // while the extinction, the surfaces and the settings it reads stay the same).
+  double occlusionMilliseconds = 0.0;
+  int64_t samples = 0;        // volume samples taken
+  int width = 0, height = 0;  // actual rendered resolution (smaller in preview)
 };
 
 }  // namespace visopt

@@ -74,10 +74,23 @@ struct Engine::Impl {
   // optimisation's moves): ClearView extracts its layers again when it changes.
   uint64_t sceneRevision = 0;
   std::unique_ptr<ClearViewCache> clearView;
+  // Ambient occlusion of the volume's samples (render/renderer.h): allocated only while a render
+  // asks for ambient occlusion with an ambient term, recomputed when what it reads changes.
+  struct OcclusionKey {
+    uint64_t scene = 0, importance = 0;
+    int table = 0, method = 0;
+    float radius = 0.f, cutThreshold = 0.f;
+    bool optimized = true;
+    std::vector<bool> visible;
+    bool operator==(const OcclusionKey&) const = default;
+  };
+  std::optional<Field3D> volumeOcclusion;
+  OcclusionKey occlusionKey;
 
   explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
 
   void clearScene() {
+    volumeOcclusion.reset();
     volumeBlockRange.reset();
     if (volumeBlockRangeToken) ledger.remove(volumeBlockRangeToken);
     volumeBlockRangeToken = 0;
@@ -169,6 +182,7 @@ struct Engine::Impl {
     if (worldMaskWords) s.worldMask = worldMaskWords->view();
     if (volumeBlockRange) s.volumeBlockRange = &*volumeBlockRange;
     if (s.extinctionChange && changeBlockRange) s.changeBlockRange = &*changeBlockRange;
+    if (volumeOcclusion) s.volumeOcclusion = &*volumeOcclusion;
     if (lightTransmittance) {
       s.lightFrustum = &lightFrustum;
       s.lightTransmittance = &*lightTransmittance;
@@ -200,6 +214,40 @@ struct Engine::Impl {
     if (volumeBlockRange) return;
     volumeBlockRange.emplace(computeBlockRange(volume->normalized));
     volumeBlockRangeToken = ledger.add("render-skip-ranges", volumeBlockRange->bytes(), "fp32");
+  }
+
+  // The volume's ambient occlusion for these settings, or none when they ask for none. A preview
+  // that reuses the last full frame's extinction change (`reuse`) reuses its occlusion too.
+  // Returns the milliseconds spent.
+  double ensureVolumeOcclusion(const RenderSettings& settings, bool reuse) {
+    if (!settings.ambientOcclusion || !(settings.ambient > 0.f) ||
+        !(settings.ambientOcclusionRadius > 0.f)) {
+      volumeOcclusion.reset();
+      return 0.0;
+    }
+    if (reuse && volumeOcclusion) return 0.0;
+    const GridSpec& g = volume->grid();
+    OcclusionKey key;
+    key.scene = sceneRevision;
+    key.importance = importanceRevision;
+    key.table = tableToken;
+    key.method = static_cast<int>(settings.method);
+    key.radius = settings.ambientOcclusionRadius * g.minSpacing();
+    key.cutThreshold = settings.cutAwayThreshold;
+    key.optimized = renderOptimized && optimizer.extinction() != nullptr;
+    for (const auto& spec : surfaceSpecs) key.visible.push_back(spec.visible);
+    if (volumeOcclusion && volumeOcclusion->grid() == g && key == occlusionKey) return 0.0;
+    const auto start = std::chrono::steady_clock::now();
+    if (!volumeOcclusion || volumeOcclusion->grid() != g ||
+        volumeOcclusion->precision() != precision)
+      volumeOcclusion.emplace("volume-occlusion (render)", g, precision, &ledger);
+    RenderScene s = scene(settings.method == RenderMethod::Optimized);
+    s.volumeOcclusion = nullptr;
+    computeVolumeOcclusion(s, settings.method, settings.cutAwayThreshold, key.radius,
+                           *volumeOcclusion);
+    occlusionKey = std::move(key);
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
   }
 
   // T_L for these settings; false when `abandon` stopped it (lightDirty / lightFromOlderMu then
@@ -367,8 +415,13 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
   if (!impl_->ensureLight(settings, abandon, lightMs)) return Image();
   impl_->ensureVolumeBlockRange();
   if (abandon && abandon()) return Image();
+  const double occlusionMs = impl_->ensureVolumeOcclusion(settings, reuse);
+  if (abandon && abandon()) return Image();
   Image image = renderImage(impl_->scene(optimized), settings, stats, abandon);
-  if (stats) stats->lightMilliseconds = lightMs;
+  if (stats) {
+    stats->lightMilliseconds = lightMs;
+    stats->occlusionMilliseconds = occlusionMs;
+  }
   return image;
 }
 

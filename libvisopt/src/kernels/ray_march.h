@@ -5,6 +5,8 @@
 // its in-scattering weight is T_V * (1 - exp(-mu h)) (= integral of T_V mu over the segment),
 // then T_V *= exp(-mu h). The phase function f_p blends Henyey-Greenstein with normalised
 // Blinn-Phong about the scalar gradient (as Ament et al. 2017 combine them).
+// Besides Eqs. 6-9 each sample scatters an unshadowed ambient light, darkened by the volume's
+// ambient-occlusion field when there is one (R4; kernels/volume_occlusion.h).
 // The surface term (Eq. 8) enters as the reduced surface radiance at the first hit of a context
 // surface, found by sphere tracing before the volume march, which then stops there.
 // Baselines of Fig. 10: cut-away drops surface and volume where ghat > threshold; transparency
@@ -88,6 +90,9 @@ struct RayMarchParams {
   uint32_t seed = 1;
   float hg = 0.f, kd = 1.f, ks = 0.f, shininess = 1.f, surfaceGradient = 0.04f;
   float ambient = 0.f;
+  // The ambient light's transmittance at each voxel (kernels/volume_occlusion.h, R4 of Himmler &
+  // Günther 2026), trilinear at the samples; invalid -> unoccluded.
+  FieldView volumeOcclusion;
   glm::vec3 background{0.f};
   float earlyStop = 1e-4f;
   glm::vec3* pixels = nullptr;  // row 0 at the top
@@ -356,7 +361,9 @@ struct RayMarchKernel {
         }
         const float lightT =
             lightTransmittanceAt(lr, t, dist, p.camera.eye + t * dir, toLight, surfaceWeight);
-        const glm::vec3 scattered = albedo * (phase * lightT * p.lightRadiance + ambient);
+        const glm::vec3 occludedAmbient =
+            p.volumeOcclusion.valid() ? ambient * raySample(p.volumeOcclusion, idx) : ambient;
+        const glm::vec3 scattered = albedo * (phase * lightT * p.lightRadiance + occludedAmbient);
         if (method == RayMethod::MaxImportance) {
           const float g = p.surf.importance.sample(idx);
           if (g > bestG) {

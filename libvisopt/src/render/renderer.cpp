@@ -185,6 +185,11 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   p.shininess = settings.shininess;
   p.surfaceGradient = std::max(settings.surfaceGradient, 1e-6f);
   p.ambient = settings.ambient;
+  if (scene.volumeOcclusion && settings.ambientOcclusion && settings.ambient > 0.f) {
+    if (scene.volumeOcclusion->grid().dims != grid.dims)
+      throw Error(ErrorKind::Failure, "the volume occlusion field is not on the volume's grid");
+    p.volumeOcclusion = FieldView(*scene.volumeOcclusion);
+  }
   p.background = settings.background;
   p.earlyStop = settings.earlyStop;
   // Context surfaces and the baselines' inputs.

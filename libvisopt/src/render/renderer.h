@@ -40,6 +40,9 @@ struct RenderScene {
   // computed for the frame.
   const DeviceBuffer<glm::vec2>* volumeBlockRange = nullptr;
   const DeviceBuffer<glm::vec2>* changeBlockRange = nullptr;
+  // Ambient occlusion of the volume's samples (computeVolumeOcclusion) on the volume's grid;
+  // null: the volume's ambient light is unoccluded (surface hits keep their own occlusion).
+  const Field3D* volumeOcclusion = nullptr;
 };
 
 // The range of a field on the volume's grid over each empty-space block (kernels/ray_skip.h,
@@ -51,6 +54,13 @@ DeviceBuffer<glm::vec2> computeBlockRange(const Field3D& field);
 // level's mu works too): RenderScene::extinctionChange.
 void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>& transfer,
                              const Field3D& mu, Field3D& out);
+
+// Ambient occlusion of each voxel (kernels/volume_occlusion.h: the mean transmittance of the six
+// axis rays of length `radius`, world units) through the extinction and the visible surfaces of
+// `scene` as `method` draws them (cut-away and transparency modulation with the scene's ghat and
+// g); `out` on the volume's grid.
+void computeVolumeOcclusion(const RenderScene& scene, RenderMethod method, float cutThreshold,
+                            float radius, Field3D& out);
 
 // T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h).
 // `abandon` (may be empty) is polled between bands of light rays: when it returns true the

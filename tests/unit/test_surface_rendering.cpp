@@ -147,9 +147,12 @@ TEST(SurfaceRendering, DeviationViewColoursByTheBaseDistance) {
   EXPECT_LT(magma.at(16, 16).z, 0.2f * img.at(16, 16).z) << "the colormap setting is ignored";
 }
 
+// A sanity check beside the defining properties (test_fig10_baselines). The scene needs context
+// surfaces that exist at this resolution: shepp-logan's thin shell at 48^3 mostly falls below its
+// isovalue, and with no surface in the way cut-away and ours draw the same optimised volume.
 TEST(SurfaceRendering, TheFourMethodsDiffer) {
   Engine e;
-  e.loadBuiltinScene("shepp-logan", 48);
+  e.loadBuiltinScene("level-set-cases", 48);
   e.setViewportSize(64, 64);
   ExtinctionSettings s;
   s.levels = 2;
@@ -166,7 +169,8 @@ TEST(SurfaceRendering, TheFourMethodsDiffer) {
   }
   for (size_t a = 0; a < images.size(); ++a)
     for (size_t b = a + 1; b < images.size(); ++b)
-      EXPECT_LT(psnr(images[a], images[b]), 45.0) << a << " vs " << b;
+      EXPECT_LT(psnr(images[a], images[b]), 45.0)
+          << a << " vs " << b << ": " << psnr(images[a], images[b]);
 }
 
 // Volume ambient occlusion (ray_march.h): the ambient light on a surface is dimmed by the

@@ -1081,50 +1081,63 @@ void MainWindow::compareMethods() {
   base.width = std::max(64, viewport_->width() / 2);
   base.height = std::max(64, viewport_->height() / 2);
   const Camera camera = viewport_->camera();
-  controller_->post(tr("Compare methods"), [this, base, camera](Engine& e) {
-    e.setCamera(camera);
-    std::vector<std::pair<QString, QImage>> images;
-    const std::pair<RenderMethod, QString> methods[] = {
-        {RenderMethod::MaxImportanceProjection, tr("Max. importance projection")},
-        {RenderMethod::CutAway, tr("Cut-away")},
-        {RenderMethod::TransparencyModulation, tr("Transparency modulation")},
-        {RenderMethod::Optimized, tr("Optimised (ours)")}};
-    try {
-      // The baselines read ghat (Eq. 19), which an optimisation iteration leaves behind; with
-      // none yet (paused from the start), one iteration at the current view provides it.
-      if (!e.importanceBehind() && e.hasImportance()) {
-        const bool frozen = e.frozen();
-        e.setFrozen(false);
-        e.continueOptimization(1);
-        e.setFrozen(frozen);
-      }
-      for (const auto& [method, label] : methods) {
-        RenderSettings s = base;
-        s.method = method;
-        const Image img = e.render(s);
-        const auto rgba = img.toSrgb8();
-        QImage q(rgba.data(), img.width, img.height, QImage::Format_RGBA8888);
-        images.emplace_back(label, q.copy());
-      }
-    } catch (const std::exception& error) {
-      const QString msg = tr("Compare methods: %1").arg(QString::fromUtf8(error.what()));
-      QMetaObject::invokeMethod(
-          this,
-          [this, msg] {
-            comparisonView_->setBusy(false);
-            showError(msg);
-          },
-          Qt::QueuedConnection);
-      return;
-    }
-    QMetaObject::invokeMethod(
-        this,
-        [this, images] {
-          comparisonView_->setImages(images);
-          comparisonView_->setBusy(false);
-        },
-        Qt::QueuedConnection);
-  });
+  controller_->postLong(
+      tr("Compare methods"), [this, base, camera](Engine& e, const ProgressCallback& progress) {
+        e.setCamera(camera);
+        std::vector<std::pair<QString, QImage>> images;
+        const std::pair<RenderMethod, QString> methods[] = {
+            {RenderMethod::MaxImportanceProjection, tr("Max. importance projection")},
+            {RenderMethod::CutAway, tr("Cut-away")},
+            {RenderMethod::TransparencyModulation, tr("Transparency modulation")},
+            {RenderMethod::Optimized, tr("Optimised (ours)")}};
+        try {
+          // Cut-away and transparency modulation draw the extinction optimised as in [9] (the
+          // surfaces held): its run shows progress and can be cancelled.
+          bool cancelled = false;
+          if (e.hasImportance()) {
+            const ExtinctionSettings& xs = e.extinctionSettings();
+            const double total = double(std::max(1, xs.levels * xs.maxIterationsPerLevel));
+            int done = 0;
+            e.optimizeBaseline(
+                [&](const IterationStats&) {
+                  cancelled = !progress(float(std::min(1.0, ++done / total)),
+                                        "baselines' volume (the optimisation of [9])");
+                  return !cancelled;
+                },
+                [&] { return cancelled; });
+          }
+          if (cancelled) {
+            QMetaObject::invokeMethod(
+                this, [this] { comparisonView_->setBusy(false); }, Qt::QueuedConnection);
+            return;
+          }
+          for (const auto& [method, label] : methods) {
+            RenderSettings s = base;
+            s.method = method;
+            const Image img = e.render(s);
+            const auto rgba = img.toSrgb8();
+            QImage q(rgba.data(), img.width, img.height, QImage::Format_RGBA8888);
+            images.emplace_back(label, q.copy());
+          }
+        } catch (const std::exception& error) {
+          const QString msg = tr("Compare methods: %1").arg(QString::fromUtf8(error.what()));
+          QMetaObject::invokeMethod(
+              this,
+              [this, msg] {
+                comparisonView_->setBusy(false);
+                showError(msg);
+              },
+              Qt::QueuedConnection);
+          return;
+        }
+        QMetaObject::invokeMethod(
+            this,
+            [this, images] {
+              comparisonView_->setImages(images);
+              comparisonView_->setBusy(false);
+            },
+            Qt::QueuedConnection);
+      });
 }
 
 void MainWindow::rebuildEngine(Precision precision) {

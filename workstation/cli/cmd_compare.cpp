@@ -30,8 +30,9 @@ Runner addCompareCommand(CLI::App& app) {
       ->default_str("");
   app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST")->default_str("the scene's view");
   app.add_option("--size", o->size, "Size WxH of each of the four images");
-  app.add_option("--iterations", o->iterations, "Iteration cap per level for ours");
-  app.add_option("--levels", o->levels, "Multigrid levels for ours");
+  app.add_option("--iterations", o->iterations,
+                 "Iteration cap per level, for ours and for the baselines' volume");
+  app.add_option("--levels", o->levels, "Multigrid levels, for ours and for the baselines' volume");
   app.add_option("--cut-threshold", o->cut, "ghat above which the cut-away removes geometry");
   app.add_option("--clearview", o->clearview,
                  "The fifth panel's ClearView settings, as for render --clearview "
@@ -67,7 +68,8 @@ Runner addCompareCommand(CLI::App& app) {
     engine.setExtinctionSettings(s);
     // Before the optimisation, so that a malformed SPEC fails at once.
     const ClearViewSettings cv = parseClearViewSpec(engine, o->clearview, size);
-    engine.optimize();  // ours, and ghat for the baselines
+    engine.optimize();          // ours
+    engine.optimizeBaseline();  // cut-away's and transparency's volume: [9], surfaces held
 
     const RenderMethod methods[4] = {RenderMethod::MaxImportanceProjection, RenderMethod::CutAway,
                                      RenderMethod::TransparencyModulation, RenderMethod::Optimized};

@@ -21,6 +21,7 @@ struct Camera {
   static Camera orbitBounds(const Bounds& bounds, float azimuthDeg, float elevationDeg,
                             float distanceInRadii);
   glm::vec3 forward() const { return glm::normalize(target - eye); }
+  bool operator==(const Camera&) const = default;
 };
 
 // The orbit distances a view may use, in bounding-sphere radii: nearer than kMinOrbitRadii the
@@ -45,6 +46,7 @@ struct PointLight {
 
   // A light above-left of the camera, a photographer's key light: the default for scenes.
   static PointLight keyLightFor(const Camera& camera, const Bounds& bounds);
+  bool operator==(const PointLight&) const = default;
 };
 
 // Throws Error(Usage) unless the light is usable with `bounds`: a finite position within

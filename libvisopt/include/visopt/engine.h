@@ -156,8 +156,24 @@ class Engine {
   void resetOptimization();
   bool hasOptimizedExtinction() const;
   const Field3D* optimizedExtinction() const;
+  // The Fig. 10 baselines' volume (Himmler & Günther 2026, §IV-A: cut-away and transparency
+  // modulation "both utilize the extinction optimization of [9] for the volume"): the extinction
+  // optimised coarse to fine from mu_bar with the context surfaces held at phi0 and taking no
+  // part in the visibility (the surfaces are cut or faded by ghat instead), and that run's ghat
+  // (Eq. 19). Computed for the current camera, light, viewport, importance, transfer function
+  // and extinction settings; kept while they stay, so a call with nothing changed returns {}
+  // at once. render() of either baseline calls it (with no callback) when it is not current.
+  // Runs while frozen too (freezing concerns ours). `callback` and `abandon` as for optimize():
+  // an abandoned run leaves no baseline, and the next call starts again.
+  std::vector<IterationStats> optimizeBaseline(
+      const std::function<bool(const IterationStats&)>& callback = {},
+      const std::function<bool()>& abandon = {});
+  // The baselines' optimised extinction and ghat, when current; null otherwise.
+  const Field3D* baselineExtinction() const;
+  const Field3D* baselineImportanceBehind() const;
+
   // Render with the optimised mu (default when there is one) or with the transfer function's
-  // mu_bar.
+  // mu_bar (the baselines then draw mu_bar too).
   void setRenderOptimized(bool useOptimized);
   bool renderOptimized() const;
 

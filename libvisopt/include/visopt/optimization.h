@@ -39,6 +39,7 @@ struct ExtinctionSettings {
   float frustumScale = 0.5f;
   int depthCells = 0;
   int lightGridSize = 128;  // light frustum rays per side at the finest level
+  bool operator==(const ExtinctionSettings&) const = default;
 };
 
 // A circular importance lens (Himmler & Günther 2026, §III-F, Fig. 8): inside it the importance

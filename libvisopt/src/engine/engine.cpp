@@ -48,7 +48,11 @@ struct Engine::Impl {
   // way to a newer camera, partly through it): a full frame recomputes it, a preview may use it
   // (lightDirty, by contrast, means the light, the transfer function or the scene changed).
   bool lightFromOlderMu = false;
-  bool lightOptimized = true;  // T_L was computed for the optimised scene
+  // What T_L was computed for: the method (the scene it draws, and the baselines' surface
+  // rules), the cut-away threshold and the baseline it drew (baselineRevision).
+  RenderMethod lightMethod = RenderMethod::Optimized;
+  float lightCut = 0.f;
+  uint64_t lightBaseline = 0;
   int lightGridSize = 0, lightGridDepth = -1;
 
   std::optional<Field3D> importance;
@@ -62,6 +66,20 @@ struct Engine::Impl {
   std::optional<Field3D> screenMask;
   ExtinctionSettings extinctionSettings;
   ExtinctionOptimizer optimizer{&ledger, Precision::FP32};
+  // The Fig. 10 baselines' volume: the optimisation of [9] with the surfaces held at phi0
+  // (Engine::optimizeBaseline), current while what it was computed for stays (baselineKey).
+  ExtinctionOptimizer baselineOptimizer{&ledger, Precision::FP32, " (baseline)"};
+  struct BaselineKey {
+    Camera camera;
+    PointLight light;
+    int width = 0, height = 0;
+    uint64_t importance = 0;
+    int table = 0;
+    ExtinctionSettings settings;
+    bool operator==(const BaselineKey&) const = default;
+  };
+  std::optional<BaselineKey> baselineKey;
+  uint64_t baselineRevision = 0;  // counts the baselines computed
   bool frozen = false;
   bool renderOptimized = true;
   // The optimised mu as the renderer draws it (render/renderer.h), refreshed at each render.
@@ -80,14 +98,56 @@ struct Engine::Impl {
     uint64_t scene = 0, importance = 0;
     int table = 0, method = 0;
     float radius = 0.f, cutThreshold = 0.f;
-    bool optimized = true;
+    const Field3D* mu = nullptr;  // the optimised mu drawn, or null for mu_bar
+    uint64_t baseline = 0;
     std::vector<bool> visible;
     bool operator==(const OcclusionKey&) const = default;
   };
   std::optional<Field3D> volumeOcclusion;
   OcclusionKey occlusionKey;
 
-  explicit Impl(Precision p) : precision(p), optimizer(&ledger, p) {}
+  explicit Impl(Precision p)
+      : precision(p), optimizer(&ledger, p), baselineOptimizer(&ledger, p, " (baseline)") {}
+
+  // What a method draws: ours (the optimised mu and surfaces), the Fig. 10 baselines' volume
+  // (cut-away and transparency modulation: the baseline mu under the base surfaces), or the
+  // scene as loaded (maximum importance projection).
+  enum class Drawn { Ours, Baseline, Base };
+  static Drawn drawnBy(RenderMethod m) {
+    if (m == RenderMethod::Optimized) return Drawn::Ours;
+    if (m == RenderMethod::CutAway || m == RenderMethod::TransparencyModulation)
+      return Drawn::Baseline;
+    return Drawn::Base;
+  }
+  // The optimised mu that `d` draws, or null for mu_bar.
+  const Field3D* muOf(Drawn d) const {
+    if (!renderOptimized) return nullptr;
+    if (d == Drawn::Ours) return optimizer.extinction();
+    if (d == Drawn::Baseline && baselineCurrent()) return baselineOptimizer.extinction();
+    return nullptr;
+  }
+  Drawn changeDrawn = Drawn::Ours;  // what extinctionChange was computed for
+
+  void resetBaseline() {
+    baselineOptimizer.reset();
+    baselineKey.reset();
+  }
+
+  BaselineKey currentBaselineKey() const {
+    return BaselineKey{camera,
+                       light,
+                       viewportWidth,
+                       viewportHeight,
+                       importanceRevision,
+                       tableToken,
+                       extinctionSettings};
+  }
+  // The baseline was computed for what the scene now is (a transfer function set since then
+  // is not baked yet: its table token is not current).
+  bool baselineCurrent() const {
+    return baselineKey && !tableDirty && *baselineKey == currentBaselineKey() &&
+           baselineOptimizer.extinction();
+  }
 
   void clearScene() {
     volumeOcclusion.reset();
@@ -95,6 +155,7 @@ struct Engine::Impl {
     if (volumeBlockRangeToken) ledger.remove(volumeBlockRangeToken);
     volumeBlockRangeToken = 0;
     optimizer.reset();
+    resetBaseline();
     importance.reset();
     importanceSource = {};
     surfaceSpecs.clear();
@@ -159,17 +220,17 @@ struct Engine::Impl {
     lightDirty = true;
   }
 
-  // The scene as drawn: `optimized` selects the optimised mu and surfaces (ours) or the base
-  // ones (mu_bar, phi0: the baselines and the "before" image).
-  RenderScene scene(bool optimized = true) const {
+  // The scene as `d` draws it: ours (the optimised mu and surfaces), the baselines' (their mu,
+  // the base surfaces phi0 and their ghat) or the one loaded (mu_bar, phi0); mu_bar throughout
+  // while the optimised mu is not drawn (setRenderOptimized).
+  RenderScene scene(Drawn d = Drawn::Ours) const {
     RenderScene s;
     s.volume = &*volume;
     s.transfer = &table;
     s.camera = camera;
     s.light = light;
-    const bool useOptimized = optimized && renderOptimized;
-    if (useOptimized && optimizer.extinction() && extinctionChange)
-      s.extinctionChange = &*extinctionChange;
+    const bool useOptimized = d == Drawn::Ours && renderOptimized;
+    if (muOf(d) && extinctionChange && changeDrawn == d) s.extinctionChange = &*extinctionChange;
     const auto phis = optimizer.surfaces();
     for (size_t i = 0; i < surfaceSpecs.size(); ++i) {
       if (!surfaceSpecs[i].visible) continue;
@@ -177,7 +238,9 @@ struct Engine::Impl {
       s.surfaceBases.push_back(&surfaceBases[i]);
       s.surfaceColors.push_back(surfaceSpecs[i].color);
     }
-    s.importanceBehind = optimizer.importanceBehind();
+    s.importanceBehind = d == Drawn::Baseline
+                             ? (baselineCurrent() ? baselineOptimizer.importanceBehind() : nullptr)
+                             : optimizer.importanceBehind();
     s.importance = importance ? &*importance : nullptr;
     if (worldMaskWords) s.worldMask = worldMaskWords->view();
     if (volumeBlockRange) s.volumeBlockRange = &*volumeBlockRange;
@@ -191,12 +254,13 @@ struct Engine::Impl {
   }
 
   // Allocated only while an optimised mu is drawn.
-  void updateExtinctionChange(bool optimized) {
-    const Field3D* mu = optimizer.extinction();
+  void updateExtinctionChange(Drawn d) {
+    const Field3D* mu = muOf(d);
+    changeDrawn = d;
     changeBlockRange.reset();
     if (changeBlockRangeToken) ledger.remove(changeBlockRangeToken);
     changeBlockRangeToken = 0;
-    if (!optimized || !renderOptimized || !mu) {
+    if (!mu) {
       extinctionChange.reset();
       return;
     }
@@ -234,14 +298,15 @@ struct Engine::Impl {
     key.method = static_cast<int>(settings.method);
     key.radius = settings.ambientOcclusionRadius * g.minSpacing();
     key.cutThreshold = settings.cutAwayThreshold;
-    key.optimized = renderOptimized && optimizer.extinction() != nullptr;
+    key.mu = muOf(drawnBy(settings.method));
+    key.baseline = drawnBy(settings.method) == Drawn::Baseline ? baselineRevision : 0;
     for (const auto& spec : surfaceSpecs) key.visible.push_back(spec.visible);
     if (volumeOcclusion && volumeOcclusion->grid() == g && key == occlusionKey) return 0.0;
     const auto start = std::chrono::steady_clock::now();
     if (!volumeOcclusion || volumeOcclusion->grid() != g ||
         volumeOcclusion->precision() != precision)
       volumeOcclusion.emplace("volume-occlusion (render)", g, precision, &ledger);
-    RenderScene s = scene(settings.method == RenderMethod::Optimized);
+    RenderScene s = scene(drawnBy(settings.method));
     s.volumeOcclusion = nullptr;
     computeVolumeOcclusion(s, settings.method, settings.cutAwayThreshold, key.radius,
                            *volumeOcclusion);
@@ -272,8 +337,9 @@ struct Engine::Impl {
     lg.dims = lightFrustum.dims;
     if (!lightTransmittance || lightTransmittance->grid().dims != lg.dims)
       lightTransmittance.emplace("light-transmittance", lg, precision, &ledger);
-    const bool done = computeLightTransmittance(scene(lightOptimized), lightFrustum,
-                                                *lightTransmittance, abandon);
+    const bool done =
+        computeLightTransmittance(scene(drawnBy(lightMethod)), lightFrustum, *lightTransmittance,
+                                  abandon, lightMethod, lightCut);
     ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!done) {
@@ -391,23 +457,36 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
   checkCamera(impl_->camera, bounds);
   checkLight(impl_->light, bounds);
   impl_->ensureTable();
-  const bool optimized = settings.method == RenderMethod::Optimized;
-  if (optimized != impl_->lightOptimized) impl_->lightDirty = true;  // T_L of the other scene
-  impl_->lightOptimized = optimized;
+  using Drawn = Impl::Drawn;
+  const Drawn drawn = Impl::drawnBy(settings.method);
+  // Cut-away and transparency modulation draw the extinction optimised as in [9].
+  if (drawn == Drawn::Baseline) {
+    optimizeBaseline({}, abandon);
+    if (!impl_->baselineCurrent()) return Image();  // abandoned
+  }
+  // T_L of another scene, or of the baselines' surfaces cut or faded otherwise.
+  const bool baseline = drawn == Drawn::Baseline;
+  if (settings.method != impl_->lightMethod ||
+      (baseline && impl_->baselineRevision != impl_->lightBaseline) ||
+      (settings.method == RenderMethod::CutAway && settings.cutAwayThreshold != impl_->lightCut))
+    impl_->lightDirty = true;
+  impl_->lightMethod = settings.method;
+  impl_->lightCut = settings.cutAwayThreshold;
+  impl_->lightBaseline = baseline ? impl_->baselineRevision : 0;
   // A preview while the optimisation runs (the user drags the camera) draws the latest mu with
   // the T_L and extinction change of the last full frame: recomputing them took twice the
   // preview's own render time.
-  const bool reuse = settings.preview && impl_->muChanged && !impl_->lightDirty &&
-                     impl_->lightTransmittance &&
-                     (!optimized || !impl_->renderOptimized || impl_->extinctionChange);
+  const bool reuse =
+      settings.preview && impl_->muChanged && !impl_->lightDirty && impl_->lightTransmittance &&
+      (!impl_->muOf(drawn) || (impl_->extinctionChange && impl_->changeDrawn == drawn));
   if (!reuse) {
     if (impl_->muChanged) impl_->lightFromOlderMu = true;
     impl_->muChanged = impl_->followedSinceChange = false;
-    impl_->updateExtinctionChange(optimized);
-  } else if (impl_->followedSinceChange && optimized) {
+    impl_->updateExtinctionChange(drawn);
+  } else if (impl_->followedSinceChange && drawn == Drawn::Ours) {
     impl_->lightFromOlderMu = true;  // muChanged stays: the next full frame computes T_L again
     impl_->followedSinceChange = false;
-    impl_->updateExtinctionChange(optimized);
+    impl_->updateExtinctionChange(drawn);
   }
   // A full frame's T_L gives way to a newer camera too: the preview that answers it draws with
   // the T_L of an earlier mu (lightFromOlderMu), the next full frame computes it whole.
@@ -417,7 +496,7 @@ Image Engine::render(const RenderSettings& settings, RenderStats* stats,
   if (abandon && abandon()) return Image();
   const double occlusionMs = impl_->ensureVolumeOcclusion(settings, reuse);
   if (abandon && abandon()) return Image();
-  Image image = renderImage(impl_->scene(optimized), settings, stats, abandon);
+  Image image = renderImage(impl_->scene(drawn), settings, stats, abandon);
   if (stats) {
     stats->lightMilliseconds = lightMs;
     stats->occlusionMilliseconds = occlusionMs;
@@ -501,6 +580,7 @@ int Engine::addContextSurface(const ContextSurfaceSpec& spec, const ProgressCall
                                                     impl_->precision, &impl_->ledger, progress));
   impl_->surfaceSpecs.push_back(spec);
   impl_->optimizer.reset();
+  impl_->resetBaseline();
   impl_->lightDirty = true;
   ++impl_->sceneRevision;
   return int(impl_->surfaceSpecs.size()) - 1;
@@ -517,6 +597,7 @@ int Engine::addContextSurface(const ContextSurfaceSpec& spec, const Field3D& bas
   impl_->surfaceBases.push_back(std::move(base));
   impl_->surfaceSpecs.push_back(spec);
   impl_->optimizer.reset();
+  impl_->resetBaseline();
   impl_->lightDirty = true;
   ++impl_->sceneRevision;
   return int(impl_->surfaceSpecs.size()) - 1;
@@ -526,6 +607,7 @@ void Engine::clearContextSurfaces() {
   impl_->surfaceSpecs.clear();
   impl_->surfaceBases.clear();
   impl_->optimizer.reset();
+  impl_->resetBaseline();
   impl_->lightDirty = true;
   ++impl_->sceneRevision;
 }
@@ -536,6 +618,7 @@ void Engine::removeContextSurface(int index) {
   impl_->surfaceSpecs.erase(impl_->surfaceSpecs.begin() + index);
   impl_->surfaceBases.erase(impl_->surfaceBases.begin() + index);
   impl_->optimizer.reset();
+  impl_->resetBaseline();
   impl_->lightDirty = true;
   ++impl_->sceneRevision;
 }
@@ -770,6 +853,37 @@ std::vector<IterationStats> Engine::followCamera(
   return stats;
 }
 
+std::vector<IterationStats> Engine::optimizeBaseline(
+    const std::function<bool(const IterationStats&)>& callback,
+    const std::function<bool()>& abandon) {
+  OptimizationInputs in = impl_->optimizationInputs();  // bakes the table: its token is current
+  const Impl::BaselineKey key = impl_->currentBaselineKey();
+  if (impl_->baselineCurrent()) return {};
+  impl_->resetBaseline();
+  in.surfacesHeld = true;
+  bool abandoned = false;
+  const std::function<bool()> watch = [&] {
+    abandoned = abandoned || (abandon && abandon());
+    return abandoned;
+  };
+  auto stats = impl_->baselineOptimizer.runMultigrid(in, impl_->extinctionSettings, callback,
+                                                     abandon ? watch : std::function<bool()>{});
+  if (abandoned || !impl_->baselineOptimizer.extinction()) {
+    impl_->resetBaseline();  // a part-way run is no baseline
+    return stats;
+  }
+  impl_->baselineKey = key;
+  ++impl_->baselineRevision;
+  return stats;
+}
+
+const Field3D* Engine::baselineExtinction() const {
+  return impl_->baselineCurrent() ? impl_->baselineOptimizer.extinction() : nullptr;
+}
+const Field3D* Engine::baselineImportanceBehind() const {
+  return impl_->baselineCurrent() ? impl_->baselineOptimizer.importanceBehind() : nullptr;
+}
+
 void Engine::setFrozen(bool frozen) {
   impl_->frozen = frozen;
 }
@@ -779,6 +893,7 @@ bool Engine::frozen() const {
 
 void Engine::resetOptimization() {
   impl_->optimizer.reset();
+  impl_->resetBaseline();
   impl_->lightDirty = true;
   ++impl_->sceneRevision;
 }

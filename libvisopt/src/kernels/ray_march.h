@@ -9,9 +9,11 @@
 // ambient-occlusion field when there is one (R4; kernels/volume_occlusion.h).
 // The surface term (Eq. 8) enters as the reduced surface radiance at the first hit of a context
 // surface, found by sphere tracing before the volume march, which then stops there.
-// Baselines of Fig. 10: cut-away drops surface and volume where ghat > threshold; transparency
-// modulation scales opacity by (1 - ghat) and blends the first surface with what lies behind;
-// maximum importance projection shows the sample (volume or surface) of highest g.
+// Baselines of Fig. 10 (§IV-A): cut-away drops the surface where ghat > threshold; transparency
+// modulation gives the first surface opacity 1 - ghat and blends it with what lies behind; both
+// draw the volume as given (the Engine gives them the extinction optimised as in [9], with the
+// surfaces held at phi0). Maximum importance projection shows the sample (volume or surface) of
+// highest g.
 //
 // Performance notes (the arithmetic is the same as the straightforward formulation):
 //  - value and central-difference gradient come from one 32-voxel neighbourhood
@@ -319,14 +321,6 @@ struct RayMarchKernel {
         float mu = p.transfer.extinction(entry);
         if (p.extinctionChange.valid())
           mu = extinctionWithChange(mu, raySample(p.extinctionChange, idx));
-        if (method == RayMethod::CutAway || method == RayMethod::Transparency) {
-          // Occluders in front of important structures go (cut-away) or fade (transparency
-          // modulation); the important structures themselves stay.
-          const float gh = fminf(fmaxf(p.surf.importanceBehind.sample(idx), 0.f), 1.f);
-          const float occluder = gh * (1.f - fminf(fmaxf(p.surf.importance.sample(idx), 0.f), 1.f));
-          mu = method == RayMethod::CutAway ? (occluder > p.surf.cutThreshold ? 0.f : mu)
-                                            : mu * (1.f - occluder);
-        }
         const float opticalDepth = mu * seg;
         if (opticalDepth < kRayMinOpticalDepth) continue;
         const float alpha = raySegmentAlpha(opticalDepth);

@@ -16,6 +16,7 @@
 #include "core/frustum_map.h"
 #include "core/hd.h"
 #include "kernels/ray_box.h"
+#include "kernels/surface_render.h"
 #include "kernels/surface_set.h"
 
 namespace visopt {
@@ -28,7 +29,10 @@ struct TransmittanceScan {
   FieldView out;  // dims == frustum.dims
   ExtinctionAt extinction;
   bool midpoint = true;
-  SurfaceSet surfaces;  // opaque: from the first cell centre inside one, T = 0
+  SurfaceSet surfaces;
+  RayMethod method = RayMethod::Optimized;  // CutAway and Transparency change the surfaces' rule
+  FieldView importanceBehind;               // ghat on the volume grid, for those two
+  float cutThreshold = 0.3f;
 
   VISOPT_HD void operator()(int64_t ray) const {
     const int i = int(ray % frustum.dims.x), j = int(ray / frustum.dims.x);
@@ -37,14 +41,27 @@ struct TransmittanceScan {
     const glm::vec3 d = volume.directionToIndex(dir);
     const RayInterval box = intersectBox(o, d, glm::vec3(volume.dims - 1));
     float opticalDepth = 0.f;
-    bool blocked = false;
+    bool blocked = false, inside = false, faded = false;
+    float surfaceT = 1.f;  // what the surfaces a baseline cut or faded let through
     // exp only when its argument moved: cells before, past and between the volume's matter keep
     // T (most of a light frustum's cells; the same bits as evaluating it every cell).
     float lastArgument = 0.f, lastT = 1.f;
     for (int k = 0; k < frustum.dims.z; ++k) {
       if (!surfaces.empty() && !blocked && !box.empty()) {
         const float s = frustum.depthOf(float(k));
-        blocked = s >= box.t0 && s <= box.t1 && surfaces.unionAt(o + s * d) < 0.f;
+        const glm::vec3 x = o + s * d;
+        const bool in = s >= box.t0 && s <= box.t1 && surfaces.unionAt(x) < 0.f;
+        if (in && !inside) {  // entering a surface's interior
+          if (method == RayMethod::CutAway) {
+            blocked = !(importanceBehind.sample(x) > cutThreshold);
+          } else if (method == RayMethod::Transparency) {
+            if (!faded) surfaceT = fminf(fmaxf(importanceBehind.sample(x), 0.f), 1.f);
+            faded = true;
+          } else {
+            blocked = true;
+          }
+        }
+        inside = in;
       }
       if (blocked) {
         out.store(out.index(i, j, k), 0.f);
@@ -61,7 +78,7 @@ struct TransmittanceScan {
         lastArgument = argument;
         lastT = expf(-argument);
       }
-      out.store(out.index(i, j, k), lastT);
+      out.store(out.index(i, j, k), surfaceT * lastT);
       opticalDepth += tau;
     }
   }

@@ -34,17 +34,16 @@ namespace visopt {
 constexpr float kOcclusionMaxDepthPerVoxel = 20.f;
 
 // Pass 1, per voxel: the extinction per world length as the renderer draws it: the optimised mu
-// (or mu_bar), modulated by the baselines as the ray marcher does, opaque inside a surface
-// (`cap` = kOcclusionMaxDepthPerVoxel / the smallest spacing, which every axis's depth per voxel
-// then reaches), with a baseline's fractional surface opacity blended towards opaque.
+// (or mu_bar), opaque inside a surface (`cap` = kOcclusionMaxDepthPerVoxel / the smallest
+// spacing, which every axis's depth per voxel then reaches), with a baseline's fractional surface
+// opacity blended towards opaque.
 struct OcclusionExtinctionPerVoxel {
   VolumeExtinction extinction;
   SurfaceSet surfaces;
   RayMethod method = RayMethod::Optimized;
-  FieldView importanceBehind, importance;  // the baselines' ghat and g
+  FieldView importanceBehind;  // the baselines' ghat, on the volume's grid
   float cutThreshold = 0.3f;
   float cap = 20.f;
-  glm::ivec3 dims{1};
   float* mu = nullptr;
 
   VISOPT_HD void operator()(int64_t v) const {
@@ -54,19 +53,13 @@ struct OcclusionExtinctionPerVoxel {
     const float base = extinction.transfer.at(extinction.scalars.load(i)).w;
     float m =
         extinction.change.valid() ? extinctionWithChange(base, extinction.change.load(i)) : base;
-    const bool baseline = method == RayMethod::CutAway || method == RayMethod::Transparency;
-    float gh = 0.f;
-    if (baseline) {  // as kernels/ray_march.h modulates the volume's samples
-      const int64_t nx = dims.x, ny = dims.y;
-      const glm::vec3 idx(float(v % nx), float((v / nx) % ny), float(v / (nx * ny)));
-      gh = fminf(fmaxf(importanceBehind.sample(idx), 0.f), 1.f);
-      const float occluder = gh * (1.f - fminf(fmaxf(importance.sample(idx), 0.f), 1.f));
-      m = method == RayMethod::CutAway ? (occluder > cutThreshold ? 0.f : m) : m * (1.f - occluder);
-    }
     // Inside a surface: opaque, except where a baseline removes the surface (cut-away: ghat
-    // above the threshold; transparency modulation: its opacity is 1 - ghat).
+    // above the threshold; transparency modulation: its opacity is 1 - ghat). The volume's mu
+    // is drawn as given, as kernels/ray_march.h does.
     bool inside = false;
     for (int k = 0; k < surfaces.count; ++k) inside = inside || surfaces.phi[k].load(i) < 0.f;
+    const bool baseline = method == RayMethod::CutAway || method == RayMethod::Transparency;
+    const float gh = inside && baseline ? fminf(fmaxf(importanceBehind.load(i), 0.f), 1.f) : 0.f;
     const float surfaceOpacity = !inside                        ? 0.f
                                  : method == RayMethod::CutAway ? (gh > cutThreshold ? 0.f : 1.f)
                                  : method == RayMethod::Transparency ? 1.f - gh

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 #include <span>
+#include <utility>
 
 #include "core/brick_order.h"
 #include "core/device_buffer.h"
@@ -153,8 +154,9 @@ std::vector<float> analyticGradient(const ExtinctionProblem& p, Precision precis
 
 // ---- the optimiser ---------------------------------------------------------------------------
 
-ExtinctionOptimizer::ExtinctionOptimizer(MemoryLedger* ledger, Precision precision)
-    : ledger_(ledger), precision_(precision) {}
+ExtinctionOptimizer::ExtinctionOptimizer(MemoryLedger* ledger, Precision precision,
+                                         std::string ledgerSuffix)
+    : ledger_(ledger), precision_(precision), ledgerSuffix_(std::move(ledgerSuffix)) {}
 ExtinctionOptimizer::~ExtinctionOptimizer() = default;
 
 const Field3D* ExtinctionOptimizer::extinction() const {
@@ -239,7 +241,7 @@ std::unique_ptr<ExtinctionOptimizer::Level> ExtinctionOptimizer::newLevel(
   next->grid = levelGrid(fine, factor);
   next->shrink = factor;
   const GridSpec grid = next->grid;
-  const auto name = [&](const char* what) { return what + suffix; };
+  const auto name = [&](const char* what) { return what + ledgerSuffix_ + suffix; };
   next->mu.emplace(name("extinction"), grid, precision_, ledger_);
   const GridMap fineMap(fine);
   if (!next->finest) {
@@ -366,8 +368,9 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(Level& L,
     L.viewMax.reset();
     L.lightMax.reset();
   }
-  SurfaceSet surfaces;
-  for (size_t si = 0; si < L.phi.size() && si < size_t(kMaxContextSurfaces); ++si)
+  SurfaceSet surfaces;  // held surfaces occlude nothing in the scans
+  for (size_t si = 0; !in.surfacesHeld && si < L.phi.size() && si < size_t(kMaxContextSurfaces);
+       ++si)
     surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
   const ScreenWeights weights = screenWeightsOf(in);
   auto t0 = Clock::now();
@@ -537,6 +540,10 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, bo
                           if (order.voxel(n, i, j, k)) behind(i, j, k);
                         });
     }
+  }
+  if (in.surfacesHeld) {  // ghat only: the surfaces stay at phi0
+    st.sdfStepMs = msSince(t0);
+    return;
   }
   const DeviceBitMask* mask = L.finest ? in.worldMask : (L.mask ? &*L.mask : nullptr);
   // The bricks of each band that this ghat leaves as they are (narrow_band.h), once per ghat.

@@ -40,6 +40,11 @@ struct OptimizationInputs {
   // Changes (to any value) whenever `importance`, `lens` or `screenMask` change: ghat (Eq. 19)
   // is kept from iteration to iteration while it and the frusta stay the same.
   uint64_t importanceRevision = 0;
+  // The surfaces stay at phi0 and take no part in the visibility scans: the volume-only
+  // optimisation of [9] that the Fig. 10 baselines draw under their cut or faded surfaces
+  // (Himmler & Günther 2026, §IV-A). ghat (Eq. 19) is still computed for them; it reads no
+  // surface (kernels/visibility_scan.h's running maximum ignores them).
+  bool surfacesHeld = false;
 };
 
 // Returning false from the callback stops the run after that iteration.
@@ -73,7 +78,8 @@ std::vector<float> analyticGradient(const ExtinctionProblem& problem, Precision 
 
 class ExtinctionOptimizer {
  public:
-  ExtinctionOptimizer(MemoryLedger* ledger, Precision precision);
+  // `ledgerSuffix` ends the names of its fields in the ledger (a second optimiser's, say).
+  ExtinctionOptimizer(MemoryLedger* ledger, Precision precision, std::string ledgerSuffix = {});
   ~ExtinctionOptimizer();
 
   // Coarse to fine from mu_bar: each level runs to its tolerance or iteration cap, then mu is
@@ -138,6 +144,7 @@ class ExtinctionOptimizer {
 
   MemoryLedger* ledger_;
   Precision precision_;
+  std::string ledgerSuffix_;
   std::unique_ptr<Level> level_;
   // follow(): the coarsest level restricted from level_, and its mu and phi when its change was
   // last prolonged onto level_.

@@ -131,17 +131,28 @@ void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>
 }
 
 bool computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
-                               Field3D& out, const std::function<bool()>& abandon) {
+                               Field3D& out, const std::function<bool()>& abandon,
+                               RenderMethod method, float cutThreshold) {
   if (out.grid().dims != lightFrustum.dims)
     throw Error(ErrorKind::Failure, "light transmittance field does not match its frustum");
-  TransmittanceScan<VolumeExtinction> scan{FrustumMap(lightFrustum),
-                                           GridMap(scene.volume->grid()),
-                                           FieldView(out),
-                                           extinctionOf(scene),
-                                           true,
-                                           {}};
+  TransmittanceScan<VolumeExtinction> scan;
+  scan.frustum = FrustumMap(lightFrustum);
+  scan.volume = GridMap(scene.volume->grid());
+  scan.out = FieldView(out);
+  scan.extinction = extinctionOf(scene);
+  scan.midpoint = true;
   for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i)
     scan.surfaces.phi[scan.surfaces.count++] = FieldView(*scene.surfaces[i]);
+  // The baselines' surfaces as drawn: cut or faded by ghat (kernels/transmittance_scan.h).
+  if ((method == RenderMethod::CutAway || method == RenderMethod::TransparencyModulation) &&
+      !scan.surfaces.empty()) {
+    if (!scene.importanceBehind)
+      throw Error(ErrorKind::Usage,
+                  std::string("the ") + toString(method) + " baseline's light needs ghat (Eq. 19)");
+    scan.method = method == RenderMethod::CutAway ? RayMethod::CutAway : RayMethod::Transparency;
+    scan.importanceBehind = FieldView(*scene.importanceBehind);
+    scan.cutThreshold = cutThreshold;
+  }
   const int64_t rays = int64_t(lightFrustum.dims.x) * lightFrustum.dims.y;
   if (!abandon) {
     exec::parallelFor("light transmittance", rays, scan);
@@ -208,10 +219,15 @@ Image renderImage(const RenderScene& scene, const RenderSettings& settings, Rend
   p.surf.aoRadius = settings.ambientOcclusionRadius * grid.minSpacing();
   p.surf.minStep = 0.25f * grid.minSpacing();
   p.surf.method = static_cast<RayMethod>(static_cast<int>(settings.method));
-  if (settings.method != RenderMethod::Optimized && (!scene.importanceBehind || !scene.importance))
+  // Maximum importance projection reads g; cut-away and transparency modulation read ghat
+  // (Eq. 19) where there are surfaces to cut or fade (Engine::render computes it).
+  if (settings.method == RenderMethod::MaxImportanceProjection && !scene.importance)
+    throw Error(ErrorKind::Usage, "the maximum importance projection needs an importance");
+  if ((settings.method == RenderMethod::CutAway ||
+       settings.method == RenderMethod::TransparencyModulation) &&
+      !p.surf.surfaces.empty() && !scene.importanceBehind)
     throw Error(ErrorKind::Usage, std::string("the ") + toString(settings.method) +
-                                      " baseline needs an importance and a view (run an "
-                                      "optimisation step first)");
+                                      " baseline needs ghat (Eq. 19) for its surfaces");
   if (scene.importanceBehind) p.surf.importanceBehind = FieldView(*scene.importanceBehind);
   if (scene.importance) p.surf.importance = FieldView(*scene.importance);
   p.surf.cutThreshold = settings.cutAwayThreshold;

@@ -62,12 +62,16 @@ void computeExtinctionChange(const Volume& volume, const DeviceBuffer<glm::vec4>
 void computeVolumeOcclusion(const RenderScene& scene, RenderMethod method, float cutThreshold,
                             float radius, Field3D& out);
 
-// T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h).
+// T_L on the light frustum grid, midpoint discretisation (see kernels/transmittance_scan.h),
+// with the surfaces as `method` draws them: opaque, or cut away where the scene's ghat exceeds
+// `cutThreshold`, or faded to opacity 1 - ghat (the Fig. 10 baselines).
 // `abandon` (may be empty) is polled between bands of light rays: when it returns true the
 // computation stops and returns false, and `out` holds the new T_L on the bands done and what it
 // held before on the others.
 bool computeLightTransmittance(const RenderScene& scene, const FrustumGrid& lightFrustum,
-                               Field3D& out, const std::function<bool()>& abandon = {});
+                               Field3D& out, const std::function<bool()>& abandon = {},
+                               RenderMethod method = RenderMethod::Optimized,
+                               float cutThreshold = 0.3f);
 
 // `abandon` (may be empty) is polled between bands of the image; when it returns true the render
 // stops and returns an empty (0 x 0) image. `settings` must have passed checkRenderSettings

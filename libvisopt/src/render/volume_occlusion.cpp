@@ -1,7 +1,7 @@
 // Host side of the volume's ambient occlusion (kernels/volume_occlusion.h): three passes per
 // axis over the volume's grid, with scratch of three floats per voxel released on return.
-#include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "core/device_buffer.h"
 #include "core/field_view.h"
@@ -37,16 +37,15 @@ void computeVolumeOcclusion(const RenderScene& scene, RenderMethod method, float
     perVoxel.surfaces.phi[perVoxel.surfaces.count++] = FieldView(*scene.surfaces[i]);
   }
   perVoxel.method = static_cast<RayMethod>(static_cast<int>(method));
-  if (method == RenderMethod::CutAway || method == RenderMethod::TransparencyModulation) {
-    if (!scene.importanceBehind || !scene.importance)
+  if ((method == RenderMethod::CutAway || method == RenderMethod::TransparencyModulation) &&
+      !perVoxel.surfaces.empty()) {
+    if (!scene.importanceBehind || scene.importanceBehind->grid().dims != dims)
       throw Error(ErrorKind::Usage, std::string("the ") + toString(method) +
-                                        " baseline's occlusion needs an importance and a view");
+                                        " baseline's occlusion needs ghat on the volume's grid");
     perVoxel.importanceBehind = FieldView(*scene.importanceBehind);
-    perVoxel.importance = FieldView(*scene.importance);
   }
   perVoxel.cutThreshold = cutThreshold;
   perVoxel.cap = kOcclusionMaxDepthPerVoxel / grid.minSpacing();
-  perVoxel.dims = dims;
   DeviceBuffer<float> mu(static_cast<size_t>(n)), prefix(static_cast<size_t>(n)),
       sum(static_cast<size_t>(n));
   perVoxel.mu = mu.data();

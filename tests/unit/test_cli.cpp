@@ -189,6 +189,41 @@ TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
             2);
 }
 
+// `compare` takes the importance a --tf preset carries, as `optimize` does: a CT-like ball (skin
+// -400 HU around bone 700 HU) with preset:ct-skin-bone and no --importance runs; a preset with no
+// importance named in --importance is a usage error naming it, and no image is written.
+TEST(Cli, CompareTakesThePresetImportanceAsOptimizeDoes) {
+  const std::string raw = tmp("ct-ball.raw");
+  {
+    std::ofstream f(raw, std::ios::binary);
+    for (int k = 0; k < 24; ++k)
+      for (int j = 0; j < 24; ++j)
+        for (int i = 0; i < 24; ++i) {
+          const float r =
+              std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
+          const float v = r < 4.f ? 700.f : (r < 9.f ? 0.f : -1000.f);
+          f.write(reinterpret_cast<const char*>(&v), 4);
+        }
+    std::ofstream(raw + ".json") << R"({"dims":[24,24,24],"type":"float32","spacing":[1,1,1]})";
+  }
+  const std::string out = tmp("ct-compare.png");
+  fs::remove(out);
+  Result r = run("compare --volume " + raw +
+                 " --tf preset:ct-skin-bone --context iso:-400 --size 24x24 --levels 1"
+                 " --iterations 1 --out " +
+                 out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out));
+  fs::remove(out);
+  r = run("compare --volume " + raw +
+          " --tf preset:ct-skin-bone --importance preset:generic"
+          " --size 24x24 --levels 1 --iterations 1 --out " +
+          out);
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(lastLine(r.err).find("preset:generic"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // Every number a user types is checked before anything runs (issue 13): NaN and infinite values,
 // cameras and lights on the volume's centre or 1e30 radii away, ray-march steps that would run
 // for hours, level-set and optimiser settings the kernels would turn into NaN fields. Each is a

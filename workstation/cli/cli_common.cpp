@@ -95,4 +95,21 @@ std::string humanBytes(size_t bytes) {
   return buf;
 }
 
+bool applyPresetImportance(Engine& engine, const std::string& importance, const std::string& scene,
+                           const std::string& tf) {
+  std::string preset;
+  if (importance.rfind("preset:", 0) == 0)
+    preset = importance.substr(7);
+  else if (importance.empty() && scene.empty() && tf.rfind("preset:", 0) == 0)
+    preset = tf.substr(7);
+  if (preset.empty()) return false;
+  const auto curve = TransferFunction::presetImportance(preset);
+  if (curve.empty() && !importance.empty())
+    throw Error(ErrorKind::Usage, "--importance " + importance +
+                                      ": this preset carries no importance (the CT presets "
+                                      "ct-skin-bone and ct-bone do)");
+  if (!curve.empty()) engine.setImportanceCurve(curve, "preset:" + preset);
+  return true;
+}
+
 }  // namespace visopt::cli

@@ -26,6 +26,10 @@ void loadInput(Engine& engine, const std::string& volume, const std::string& sce
                int sceneResolution, bool showProgress);
 // --tf: a JSON file (visopt or ParaView format) or preset:NAME.
 TransferFunction loadTransferFunction(const std::string& spec, const Volume& volume);
+// --importance preset:NAME, or, without --importance and --scene, the importance a --tf preset
+// is made for (bone for the CT presets): sets it and returns true; false when neither applies.
+bool applyPresetImportance(Engine& engine, const std::string& importance, const std::string& scene,
+                           const std::string& tf);
 
 nlohmann::json stageTimingsJson();
 nlohmann::json ledgerJson(const MemoryLedger& ledger);

@@ -25,7 +25,9 @@ Runner addCompareCommand(CLI::App& app) {
   app.add_option("--resolution", o->resolution, "Built-in scene resolution");
   app.add_option("--tf", o->tf, "Transfer function: JSON file or preset:NAME")
       ->default_str("the scene's own; preset:generic for a volume");
-  app.add_option("--importance", o->importance, "Importance curve JSON or volume");
+  app.add_option("--importance", o->importance,
+                 "Importance: curve JSON, volume, or preset:NAME (the CT presets' bone; without it "
+                 "the --tf preset's own)");
   app.add_option("--context", o->contexts, "Context surface (repeatable), as for optimize")
       ->default_str("");
   app.add_option("--camera", o->camera, "Orbit AZ,EL,DIST")->default_str("the scene's view");
@@ -45,7 +47,8 @@ Runner addCompareCommand(CLI::App& app) {
     Engine engine;
     loadInput(engine, o->volume, o->scene, o->resolution, !o->json);
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
-    if (!o->importance.empty()) engine.loadImportance(o->importance);
+    if (!applyPresetImportance(engine, o->importance, o->scene, o->tf) && !o->importance.empty())
+      engine.loadImportance(o->importance);
     if (!engine.hasImportance())
       throw Error(ErrorKind::Usage, "--importance is needed for a volume file (scenes carry one)");
     for (const auto& c : o->contexts) {

@@ -191,20 +191,8 @@ Runner addOptimizeCommand(CLI::App& app) {
     }
     loadInput(engine, o->volume, o->scene, o->resolution, !o->json && !o->quiet);
     if (!o->tf.empty()) engine.setTransferFunction(loadTransferFunction(o->tf, engine.volume()));
-    // --importance preset:NAME, or, without --importance, the importance the --tf preset is
-    // made for (bone for the CT presets).
-    std::string importancePreset;
-    if (o->importance.rfind("preset:", 0) == 0)
-      importancePreset = o->importance.substr(7);
-    else if (o->importance.empty() && o->scene.empty() && o->tf.rfind("preset:", 0) == 0)
-      importancePreset = o->tf.substr(7);
-    if (!importancePreset.empty()) {
-      const auto curve = TransferFunction::presetImportance(importancePreset);
-      if (curve.empty() && !o->importance.empty())
-        throw Error(ErrorKind::Usage, "--importance " + o->importance +
-                                          ": this preset carries no importance (the CT presets "
-                                          "ct-skin-bone and ct-bone do)");
-      if (!curve.empty()) engine.setImportanceCurve(curve, "preset:" + importancePreset);
+    if (applyPresetImportance(engine, o->importance, o->scene, o->tf)) {
+      // --importance preset:NAME or the --tf preset's own importance is set.
     } else if (o->importance.rfind("hotspot:", 0) == 0) {
       const std::vector<float> v = parseFloats(o->importance.substr(8), ',', "--importance");
       if (v.size() != 4)

@@ -3,8 +3,9 @@
 //   left:   important in front of the context   -> the isocontour does not change;
 //   middle: important nested inside a shell     -> the front wall opens, the back wall stays;
 //   right:  important behind a context rod      -> the rod's occluding middle shrinks from front
-//           and back until the isocontour splits in two; it returns to its initial shape when
-//           the occlusion is gone (the camera turned to the other side).
+//           and back until the isocontour splits in two, whose parts move apart until their
+//           tips reach the ball's silhouette; it returns to its initial shape when the
+//           occlusion is gone (the camera turned to the other side).
 // Everything is measured on the surface's SDF (phi against its base phi0), not on images.
 #include <gtest/gtest.h>
 
@@ -97,6 +98,21 @@ bool rightRod(glm::vec3 p) {  // the context rod of the right case, in front of 
   return p.x > 0.36f && p.y < -0.1f;
 }
 
+// The rod's gap along its axis (x = 0.54, y = -0.3, normalised): the extent in z of {phi > 0}
+// around z = 0, in voxels; 0 while the rod is whole. Its two ends are the split parts' tips.
+struct RodGap {
+  float lower = 0.f, upper = 0.f;  // normalised z of the tips facing the gap
+  float voxels(const GridSpec& g) const { return (upper - lower) * kHalf / g.minSpacing(); }
+};
+RodGap rodGap(const Field3D& phi) {
+  const float dz = 0.25f * phi.grid().minSpacing() / kHalf;
+  RodGap gap;
+  if (phiAt(phi, {0.54f, -0.3f, 0.f}) <= 0.f) return gap;
+  while (gap.upper < 0.5f && phiAt(phi, {0.54f, -0.3f, gap.upper + dz}) > 0.f) gap.upper += dz;
+  while (gap.lower > -0.5f && phiAt(phi, {0.54f, -0.3f, gap.lower - dz}) > 0.f) gap.lower -= dz;
+  return gap;
+}
+
 struct CasesRun {
   Engine engine;
   std::vector<IterationStats> stats;
@@ -138,7 +154,21 @@ TEST(LevelSetCasesScene, NestedObjectOpensTheFrontWallAndKeepsTheBackWall) {
   }
 }
 
-TEST(LevelSetCasesScene, ObjectBehindARodSplitsItInTwo) {
+// On the rod's axis, the largest |z| at which the ray from `eye` (normalised) through the axis
+// passes the important ball (centre (0.62, 0.25, 0), radius 0.18): the ball's silhouette on it.
+float ballSilhouetteOnRodAxis(glm::vec3 eye) {
+  const glm::vec3 ball(0.62f, 0.25f, 0.f);
+  auto hidesBall = [&](float z) {
+    const glm::vec3 d = glm::normalize(glm::vec3(0.54f, -0.3f, z) - eye);
+    const glm::vec3 c = ball - eye;
+    return glm::length(c - glm::dot(c, d) * d) < 0.18f;
+  };
+  float lo = 0.f, hi = 0.5f;
+  for (int n = 0; n < 40; ++n) (hidesBall(0.5f * (lo + hi)) ? lo : hi) = 0.5f * (lo + hi);
+  return lo;
+}
+
+TEST(LevelSetCasesScene, ObjectBehindARodSplitsItAndThePartsMoveApartToItsSilhouette) {
   for (Precision p : {Precision::FP32, Precision::FP16}) {
     SCOPED_TRACE(name(p));
     CasesRun run(p);
@@ -151,6 +181,15 @@ TEST(LevelSetCasesScene, ObjectBehindARodSplitsItInTwo) {
     for (float z : {-0.35f, 0.35f})
       EXPECT_NEAR(phiAt(run.phi(), {0.54f, -0.3f, z}), phiAt(run.phi0(), {0.54f, -0.3f, z}), 0.1)
           << "z " << z;
+    // The two parts moved apart until their tips reach the ball's silhouette as the camera sees
+    // it (ghat > 0 exactly where a view ray from the rod meets the ball), and no farther (there
+    // the return term of Eq. 23 holds them): each tip within one voxel of it.
+    const float silhouette = ballSilhouetteOnRodAxis(run.engine.camera().eye / kHalf);
+    const float voxel = run.phi().grid().minSpacing() / kHalf;
+    const RodGap gap = rodGap(run.phi());
+    EXPECT_NEAR(gap.upper, silhouette, voxel);
+    EXPECT_NEAR(gap.lower, -silhouette, voxel);
+    EXPECT_GT(gap.voxels(run.phi().grid()), 8.f) << "apart by the silhouette's 10 voxels";
   }
 }
 

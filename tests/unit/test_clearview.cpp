@@ -518,8 +518,8 @@ TEST(ClearViewHotspotImportance, TheBallIsOneInsideHalfTheRadiusAndFallsSmoothly
 }
 
 // Paper 000's optimisation driven by the hotspot: what lies in the ball becomes visible, and mu
-// stays mu_bar on every voxel whose view ray does not go on to pass the ball (where g = 0 and
-// nothing important lies behind, the gradient rho (mu - mu_bar) - q (g T_V - G_V) is 0).
+// stays mu_bar on every voxel whose view ray and light ray do not go on to pass the ball (where g =
+// 0 and nothing important lies behind, the gradient rho (mu - mu_bar) - q (g T_V - G_V) is 0).
 TEST(ClearViewHotspotImportance, TheOptimisationOpensTheBallAndLeavesTheRestAlone) {
   Engine e;
   e.loadBuiltinScene("shepp-logan", 48, false);
@@ -546,7 +546,7 @@ TEST(ClearViewHotspotImportance, TheOptimisationOpensTheBallAndLeavesTheRestAlon
   Field3D change("change", e.volume().grid(), Precision::FP32);
   computeExtinctionChange(e.volume(), transfer, *e.optimizedExtinction(), change);
   const GridSpec& grid = e.volume().grid();
-  const glm::vec3 eye = e.camera().eye;
+  const glm::vec3 eye = e.camera().eye, light = e.light().position;
   double maxAway = 0.0, maxNear = 0.0;
   int away = 0;
   for (int k = 0; k < grid.dims.z; ++k)
@@ -557,7 +557,9 @@ TEST(ClearViewHotspotImportance, TheOptimisationOpensTheBallAndLeavesTheRestAlon
         // Five voxels of margin beyond the ball's shadow: the gather of the gradient from the
         // frustum's cells to the voxels and the smooth ball's tail (measured: changes up to 0.02
         // of the largest extinction reach 4-5 voxels beyond r, none farther).
-        if (distanceToRay(c, eye, p) > r + 5.f * grid.minSpacing()) {
+        // The default weights optimise from the light too (r = q): its rays to the ball count.
+        const float margin = r + 5.f * grid.minSpacing();
+        if (distanceToRay(c, eye, p) > margin && distanceToRay(c, light, p) > margin) {
           maxAway = std::max(maxAway, dmu);
           ++away;
         } else {

@@ -199,10 +199,14 @@ TEST(LevelSetCasesScene, SurfacesReturnWhenTheOcclusionIsGone) {
   ASSERT_GT(phiAt(run.phi(), {0.f, -0.26f, 0.f}), 1.f);
   // From the other side the rod and the shell's former front wall are behind the important
   // objects: the return term of Eq. 23 brings them back to phi0 (and the far wall opens).
+  // The key light turns with the camera: left in front, the rod would still shadow the ball
+  // from it, and ghat's light half (Eq. 19) would keep a dent in it.
   run.engine.orbitCamera(180.f, 0.f, 2.4f);
+  run.engine.setLight(
+      PointLight::keyLightFor(run.engine.camera(), run.engine.volume().grid().worldBounds()));
   run.engine.continueOptimization(40);
   EXPECT_EQ(insideComponents(run.phi(), rightRod), 1);
-  EXPECT_LT(maxDeviationNearSurface(run.phi(), run.phi0(), rightRod), 0.5);
+  EXPECT_LT(maxDeviationNearSurface(run.phi(), run.phi0(), rightRod), 0.1);
   EXPECT_NEAR(phiAt(run.phi(), {0.f, -0.26f, 0.f}), phiAt(run.phi0(), {0.f, -0.26f, 0.f}), 0.1);
   EXPECT_GT(phiAt(run.phi(), {0.f, 0.26f, 0.f}), 1.f);
 }

@@ -103,7 +103,10 @@ Runner addOptimizeCommand(CLI::App& app) {
   app.add_option("--rho", o->rho,
                  "Weight of staying close to the transfer function (<0: 1/mu_max)");
   app.add_option("--q", o->q, "Weight of seeing the important parts from the camera");
-  app.add_option("--r", o->r, "Weight of lighting the important parts (0: no light grids)");
+  app.add_option(
+      "--r", o->r,
+      "Weight of lighting the important parts (0: no light term, and no light grids without "
+      "context surfaces)");
   app.add_option("--optimizer", o->optimizer, "ademamix or adam");
   app.add_option("--lr", o->lr, "Learning rate in units of mu_max per step");
   app.add_option("--mu-max", o->muMax,
@@ -320,6 +323,9 @@ Runner addOptimizeCommand(CLI::App& app) {
       nlohmann::json j = {{"command", "optimize"},
                           {"backend", backendDescription()},
                           {"input", engine.volume().sourcePath},
+                          {"dims",
+                           {engine.volume().grid().dims.x, engine.volume().grid().dims.y,
+                            engine.volume().grid().dims.z}},
                           {"precision", o->precision},
                           {"settings",
                            {{"rho", s.rho},

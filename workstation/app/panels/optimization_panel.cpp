@@ -60,8 +60,9 @@ OptimizationPanel::OptimizationPanel(QWidget* parent) : QWidget(parent) {
   r_ = makeDoubleBox(energyGroup, "r", 0.0, 1e6, 3, 1.0);
   r_->setToolTip(
       tr("r weights the light visibility term −r ∫ g μ T_L: it removes matter that shadows "
-         "important structures from the light. 0 disables the term and allocates no light-space "
-         "grids."));
+         "important structures from the light (default 40, equal to q: the paper's joint "
+         "optimisation from view and light). 0 disables the term and, without context surfaces, "
+         "allocates no light-space grids."));
   energyForm->addRow(tr("r (light visibility)"), r_);
   layout->addWidget(energyGroup);
 

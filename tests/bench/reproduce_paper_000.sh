@@ -2,10 +2,12 @@
 # Reruns what docs/paper-000.md shows of paper 000 (Himmler & Günther 2026) on our data, from the
 # built-in scenes and, where present, the Cranium CT of datasets-scripts/fetch_datasets.sh:
 #   fig3-*          Fig. 3's three cases (builtin:level-set-cases), before and after
+#   fig4-*          Fig. 4: the earth mantle's crust filled and as a thin shell
 #   light-term-*    the light term (R1, Eq. 13): builtin:ct-head with r = 0 and the default r = q
 #   fig6-*          Fig. 6's volume ambient occlusion on the Cranium CT, with and without
 #   fig7-*          Fig. 7's deviation view and a second viewpoint (earth mantle)
-#   fig8-*          Fig. 8's importance lens (default scene), beside the run without it
+#   fig8-*          Fig. 8's view-space masks (lenses of strength 0 on the default scene)
+#   fig9-*          Fig. 9's world-space mask (stand-in continents on the earth mantle)
 #   fig10-*         Fig. 10's four methods and ClearView (level-set cases; the Cranium CT)
 #   fig11-*         Fig. 11's lambda study: the mixer and the earth mantle with thin shells
 #   fp16-fp32.md    fp16 against fp32 by FLIP (tests/bench/fp16_vs_fp32.sh)
@@ -51,10 +53,23 @@ step light-term-ct-head-r40 optimize --scene builtin:ct-head --size 256x256
 step fig7-earth-mantle-deviation optimize --scene builtin:earth-mantle --size 320x320 \
   --deviation-view --view-from 60,25,2.6
 
-# Fig. 8: an importance lens of strength 0 (it hides the importance under it) over the left of
-# the default scene, beside the same run without it.
+# Fig. 4: the earth mantle's crust as a filled surface (the scene's own) and as a thin shell.
+step fig4-earth-mantle-filled optimize --scene builtin:earth-mantle --size 256x256 --filled
+step fig4-earth-mantle-shell optimize --scene builtin:earth-mantle --size 256x256 --shell 3
+
+# Fig. 8: view-space masks, as importance lenses of strength 0 (they hide the importance under
+# them): three placements over the default scene, beside the same run without one.
 step fig8-no-lens optimize --scene builtin:shepp-logan --size 320x320
 step fig8-lens optimize --scene builtin:shepp-logan --size 320x320 --lens 120,160,50,0
+step fig8-lens-top optimize --scene builtin:shepp-logan --size 320x320 --lens 175,95,45,0
+step fig8-lens-right optimize --scene builtin:shepp-logan --size 320x320 --lens 205,175,40,0
+
+# Fig. 9: a world-space mask keeping the crust over stand-in continents (our earth has none:
+# tests/bench/continents_mask.py writes five fixed caps), beside the run without it.
+python3 "$root/tests/bench/continents_mask.py" 128 "$out/fig9-continents-mask.raw"
+step fig9-earth-mantle-no-mask optimize --scene builtin:earth-mantle --size 256x256
+step fig9-earth-mantle-mask optimize --scene builtin:earth-mantle --size 256x256 \
+  --world-mask "$out/fig9-continents-mask.raw"
 
 # Fig. 10: the baselines as defined, ours, and ClearView.
 step fig10-level-set-cases compare --scene builtin:level-set-cases --resolution 96 --size 256x256
@@ -96,7 +111,9 @@ for scene in mixer earth-mantle; do
 done
 row fig7-earth-mantle fig7-earth-mantle-deviation-before.png fig7-earth-mantle-deviation.png \
   fig7-earth-mantle-deviation-view.png
-row fig8-lens-row fig8-no-lens.png fig8-lens.png
+row fig4-earth-mantle fig4-earth-mantle-filled.png fig4-earth-mantle-shell.png
+row fig8-lens-row fig8-no-lens.png fig8-lens.png fig8-lens-top.png fig8-lens-right.png
+row fig9-earth-mantle fig9-earth-mantle-no-mask.png fig9-earth-mantle-mask.png
 row light-term-ct-head light-term-ct-head-r0.png light-term-ct-head-r40.png
 
 if [[ -z "${SKIP_TABLES:-}" ]]; then

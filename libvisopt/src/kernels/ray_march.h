@@ -68,6 +68,9 @@ VISOPT_HD inline float hashToUnit(uint32_t x) {
 
 // Pixels are launched in tiles of kRayTile x kRayTile, row by row within a tile.
 constexpr int kRayTile = 8;
+// The least importance the maximum importance projection starts a ray at (below it the ray shows
+// the base scene).
+constexpr float kMipMinImportance = 0.05f;
 
 // Launch items for a w x h image (whole tiles; items outside the image do nothing).
 inline int64_t rayMarchItems(int w, int h) {
@@ -201,7 +204,7 @@ struct RayMarchKernel {
     const glm::ivec3 dims = p.scalars.dims;
 
     const RayInterval box = intersectBox(o, d, glm::vec3(p.volume.dims - 1));
-    const float t0 = box.t0;
+    float t0 = box.t0;
     float t1 = box.t1;
     glm::vec3 radiance(0.f);
     float transmittance = 1.f;
@@ -225,6 +228,35 @@ struct RayMarchKernel {
         }
         if (hit.hit && p.surf.importanceBehind.sample(o + hit.t * d) > p.surf.cutThreshold)
           hit = SurfaceHit{};
+      }
+    }
+    // Maximum importance projection (Viola et al. 2004, extended to surfaces): where the ray
+    // meets a volume more important than its first surface hit, the ray starts at that volume
+    // (the first sample whose g reaches half the ray's maximum, less one step) and everything in
+    // front of it is cut away; the surfaces there too. Otherwise the ray is drawn as the base
+    // scene. T_L and the volume's AO of this method see the volume only (transmittance_scan.h,
+    // volume_occlusion.h): a context dropped for the eye would otherwise shadow what it shows.
+    if (method == RayMethod::MaxImportance && t1 > t0) {
+      const int count = int(ceilf((t1 - t0) / p.step));
+      const float seg = (t1 - t0) / float(count);
+      const float offset = p.jitter ? hashToUnit(uint32_t(pixel) * 9781u + p.seed * 6271u) : 0.5f;
+      float maxG = 0.f;
+      for (int s = 0; s < count; ++s)
+        maxG = fmaxf(maxG, p.surf.importance.sample(o + (t0 + (float(s) + offset) * seg) * d));
+      const float surfaceG = hit.hit ? p.surf.importance.sample(o + hit.t * d) : 0.f;
+      if (maxG > kMipMinImportance && maxG > surfaceG) {
+        int first = 0;
+        while (first < count &&
+               p.surf.importance.sample(o + (t0 + (float(first) + offset) * seg) * d) < 0.5f * maxG)
+          ++first;
+        const float start = t0 + float(first > 0 ? first - 1 : 0) * seg;
+        if (hit.hit && hit.t < start) {
+          // Leave the cut surfaces' interior, then look for a surface beyond the start.
+          float from = start;
+          while (from < t1 && p.surf.surfaces.unionAt(o + from * d) <= 0.f) from += p.surf.minStep;
+          hit = traceSurfaces(p.surf.surfaces, o, d, from, t1, p.surf.minStep);
+        }
+        t0 = start;
       }
     }
     glm::vec3 surfaceColour(0.f);
@@ -268,15 +300,8 @@ struct RayMarchKernel {
       surfaceAlpha = 1.f;
       if (method == RayMethod::Transparency)
         surfaceAlpha = 1.f - fminf(fmaxf(p.surf.importanceBehind.sample(hidx), 0.f), 1.f);
-      else if (method != RayMethod::MaxImportance)  // the projection looks through everything
+      else
         t1 = hit.t;
-    }
-    // Maximum importance projection: the most important sample's colour.
-    float bestG = 0.f;
-    glm::vec3 bestColour(0.f);
-    if (method == RayMethod::MaxImportance && hit.hit) {
-      bestG = p.surf.importance.sample(o + hit.t * d);
-      bestColour = surfaceColour;
     }
     if (t1 > t0) {
       const int count = int(ceilf((t1 - t0) / p.step));
@@ -358,13 +383,6 @@ struct RayMarchKernel {
         const glm::vec3 occludedAmbient =
             p.volumeOcclusion.valid() ? ambient * raySample(p.volumeOcclusion, idx) : ambient;
         const glm::vec3 scattered = albedo * (phase * lightT * p.lightRadiance + occludedAmbient);
-        if (method == RayMethod::MaxImportance) {
-          const float g = p.surf.importance.sample(idx);
-          if (g > bestG) {
-            bestG = g;
-            bestColour = scattered;
-          }
-        }
         // Transparency modulation: the surface sits at hit.t; blend it in when passing it.
         if (surfaceAlpha > 0.f && method == RayMethod::Transparency && t > hit.t) {
           radiance += transmittance * surfaceAlpha * surfaceColour;
@@ -380,7 +398,6 @@ struct RayMarchKernel {
       transmittance *= 1.f - surfaceAlpha;
     }
     radiance += transmittance * p.background;
-    if (method == RayMethod::MaxImportance && bestG > 0.05f) radiance = bestColour;
     p.pixels[pixel] = radiance;
     return samples;
   }

@@ -141,8 +141,10 @@ bool computeLightTransmittance(const RenderScene& scene, const FrustumGrid& ligh
   scan.out = FieldView(out);
   scan.extinction = extinctionOf(scene);
   scan.midpoint = true;
-  for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i)
-    scan.surfaces.phi[scan.surfaces.count++] = FieldView(*scene.surfaces[i]);
+  // The maximum importance projection's light sees the volume only (kernels/ray_march.h).
+  if (method != RenderMethod::MaxImportanceProjection)
+    for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i)
+      scan.surfaces.phi[scan.surfaces.count++] = FieldView(*scene.surfaces[i]);
   // The baselines' surfaces as drawn: cut or faded by ghat (kernels/transmittance_scan.h).
   if ((method == RenderMethod::CutAway || method == RenderMethod::TransparencyModulation) &&
       !scan.surfaces.empty()) {

@@ -31,7 +31,10 @@ void computeVolumeOcclusion(const RenderScene& scene, RenderMethod method, float
       TransferLookup{scene.transfer->data(), int(scene.transfer->size())};
   if (scene.extinctionChange && scene.extinctionChange->grid().dims != dims)
     throw Error(ErrorKind::Failure, "the extinction change is not on the volume's grid");
-  for (size_t i = 0; i < scene.surfaces.size() && i < size_t(kMaxContextSurfaces); ++i) {
+  // The maximum importance projection's AO sees the volume only, as its T_L does.
+  const size_t surfaceCount =
+      method == RenderMethod::MaxImportanceProjection ? 0 : scene.surfaces.size();
+  for (size_t i = 0; i < surfaceCount && i < size_t(kMaxContextSurfaces); ++i) {
     if (scene.surfaces[i]->grid().dims != dims)
       throw Error(ErrorKind::Failure, "a context surface is not on the volume's grid");
     perVoxel.surfaces.phi[perVoxel.surfaces.count++] = FieldView(*scene.surfaces[i]);

@@ -13,7 +13,7 @@ namespace visopt {
 // The comparison baselines of Himmler & Günther 2026, Fig. 10, and ours.
 enum class RenderMethod {
   Optimized,                // ours: the optimised extinction and surfaces
-  MaxImportanceProjection,  // each pixel shows the sample of highest importance (surfaces too)
+  MaxImportanceProjection,  // rays start at their most important volume, cutting what is in front
   CutAway,                  // surfaces and volume removed where ghat exceeds a threshold
   TransparencyModulation,   // surfaces and volume made transparent in proportion to ghat
 };

@@ -219,6 +219,14 @@ TEST(Fig10Baselines, TheBaselinesVolumeIsTheOptimisationWithoutSurfaces) {
   ASSERT_NE(withSurfaces.baselineExtinction(), nullptr);
   ASSERT_NE(withSurfaces.baselineImportanceBehind(), nullptr) << "ghat for cutting and fading";
   EXPECT_FALSE(withSurfaces.hasOptimizedExtinction()) << "ours stays as it was";
+  // Held surfaces take no step: the baseline holds no phi, coarse phi0 or level-set scratch.
+  bool ghatHeld = false;
+  for (const LedgerEntry& entry : withSurfaces.ledger().entries()) {
+    if (entry.name.find("(baseline)") == std::string::npos) continue;
+    EXPECT_NE(entry.name.rfind("surface", 0), 0u) << entry.name << " allocated for the baseline";
+    ghatHeld = ghatHeld || entry.name.rfind("importance-behind", 0) == 0;
+  }
+  EXPECT_TRUE(ghatHeld) << "the baseline's ghat is in the ledger";
 
   Engine without;
   loadCases(without);  // the same transfer function, the one meant for the surfaces

@@ -251,8 +251,10 @@ std::unique_ptr<ExtinctionOptimizer::Level> ExtinctionOptimizer::newLevel(
     restrictBaseAndImportance(in.volume->normalized, *in.transfer, *in.importance, fineMap,
                               *next->base, *next->importance);
   }
-  // Context surfaces: phi0 restricted onto coarse levels (the finest uses the inputs').
-  for (size_t si = 0; si < in.surfaceBases.size(); ++si) {
+  // Context surfaces: phi0 restricted onto coarse levels (the finest uses the inputs'). Held
+  // surfaces (the baselines' optimisation) take no step and occlude nothing: ghat is all they
+  // need, so they get no phi, coarse phi0, scratch or mask (model only what the scene requires).
+  for (size_t si = 0; !in.surfacesHeld && si < in.surfaceBases.size(); ++si) {
     if (!next->finest) {
       next->phi0.emplace_back(name("surface-base (coarse)"), grid, precision_, ledger_);
       restrictSdf(*in.surfaceBases[si], fineMap, next->phi0.back());
@@ -267,8 +269,8 @@ std::unique_ptr<ExtinctionOptimizer::Level> ExtinctionOptimizer::newLevel(
   next->bands.resize(next->phi.size());
   if (!in.surfaceBases.empty()) {
     next->ghat.emplace(name("importance-behind"), grid, precision_, ledger_);
-    next->scratch.emplace(name("surface-scratch"), grid, precision_, ledger_);
-    if (in.worldMask && !next->finest) {
+    if (!in.surfacesHeld) next->scratch.emplace(name("surface-scratch"), grid, precision_, ledger_);
+    if (in.worldMask && !next->finest && !in.surfacesHeld) {
       next->mask.emplace(grid.dims, name("world-mask (coarse)"), ledger_);
       resampleMask(*in.worldMask, fineMap, *next->mask, grid);
     }
@@ -337,7 +339,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(Level& L,
   // Light grids for the light term, and for the light half of ghat (Eq. 19) whenever there are
   // context surfaces: a closed surface that gave way only towards the camera leaves what it
   // revealed in its own shadow (T_L = 0 inside it), so it must give way towards the light too.
-  const bool lightGrids = s.r != 0.f || !L.phi.empty();
+  const bool lightGrids = s.r != 0.f || !in.surfaceBases.empty();
   if (lightGrids) {
     const int n = std::max(4, s.lightGridSize / shrink);
     L.light = FrustumGrid::forLight(in.light, bounds, glm::ivec3(n, n, 0), L.grid.minSpacing());
@@ -360,7 +362,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(Level& L,
 
   IterationStats st;
   st.level = L.index;
-  const bool hasSurfaces = !L.phi.empty();
+  const bool hasSurfaces = !in.surfaceBases.empty();
   const ImportanceBehindInputs ghatInputs{L.view, L.light, in.importanceRevision};
   const bool ghatKept = L.ghatFor && *L.ghatFor == ghatInputs;
   const bool ghatNeeded = hasSurfaces && !ghatKept;
@@ -369,8 +371,7 @@ std::optional<IterationStats> ExtinctionOptimizer::runIteration(Level& L,
     L.lightMax.reset();
   }
   SurfaceSet surfaces;  // held surfaces occlude nothing in the scans
-  for (size_t si = 0; !in.surfacesHeld && si < L.phi.size() && si < size_t(kMaxContextSurfaces);
-       ++si)
+  for (size_t si = 0; si < L.phi.size() && si < size_t(kMaxContextSurfaces); ++si)
     surfaces.phi[surfaces.count++] = FieldView(L.phi[si]);
   const ScreenWeights weights = screenWeightsOf(in);
   auto t0 = Clock::now();

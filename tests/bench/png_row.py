@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Puts PNG images side by side, left to right, with a white gap: the panels of a figure row.
 
-usage: png_row.py OUT.png IN.png [IN.png ...]
+usage: png_row.py [--half] OUT.png IN.png [IN.png ...]
 
-Reads the 8-bit RGB and RGBA PNGs visopt writes (non-interlaced), pads shorter images at the
+--half averages each image's 2x2 pixel blocks first (half the width and height). Reads the 8-bit RGB and RGBA PNGs visopt writes (non-interlaced), pads shorter images at the
 bottom with white, and writes an 8-bit RGB PNG. Only the standard library (zlib), so the
 reproduction script needs no image package.
 """
@@ -76,10 +76,31 @@ def write_png(path, width, height, rows):
         f.write(chunk(b"IEND", b""))
 
 
+def halved(image):  # the mean of each 2x2 block, an odd last row or column dropped
+    width, height, rows = image
+    w, h = width // 2, height // 2
+    out = []
+    for y in range(h):
+        a, b = rows[2 * y], rows[2 * y + 1]
+        line = bytearray(3 * w)
+        for x in range(w):
+            for c in range(3):
+                i = 6 * x + c
+                line[3 * x + c] = (a[i] + a[i + 3] + b[i] + b[i + 3] + 2) // 4
+        out.append(bytes(line))
+    return w, h, out
+
+
 def main():
-    if len(sys.argv) < 3:
+    args = sys.argv[1:]
+    half = bool(args) and args[0] == "--half"
+    if half:
+        args = args[1:]
+    if len(args) < 2:
         sys.exit(__doc__)
-    images = [read_png(p) for p in sys.argv[2:]]
+    images = [read_png(p) for p in args[1:]]
+    if half:
+        images = [halved(i) for i in images]
     height = max(h for _, h, _ in images)
     width = sum(w for w, _, _ in images) + GAP * (len(images) - 1)
     gap = b"\xff" * (3 * GAP)
@@ -87,7 +108,7 @@ def main():
     for y in range(height):
         parts = [r[y] if y < h else b"\xff" * (3 * w) for w, h, r in images]
         rows.append(gap.join(parts))
-    write_png(sys.argv[1], width, height, rows)
+    write_png(args[0], width, height, rows)
 
 
 if __name__ == "__main__":

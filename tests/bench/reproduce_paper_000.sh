@@ -19,8 +19,8 @@
 # usage: tests/bench/reproduce_paper_000.sh [BUILD_DIR [OUT_DIR]]   defaults: build, a temp dir
 #   (OUT_DIR=docs/paper-000 refreshes the documentation's images in place)
 # environment: DATA (default data), SKIP_SLOW=1 leaves out the Cranium Fig. 10 row (~14 min on
-#   2 cores) and Table I (~15 min), SKIP_TABLES=1 leaves out the three tables.
-# At the defaults the whole run takes about 40 minutes on 2 cores (SKIP_SLOW=1: about 4).
+#   2 cores) and Table I (~8 min), SKIP_TABLES=1 leaves out the three tables.
+# At the defaults the whole run takes about 30 minutes on 2 cores (SKIP_SLOW=1: about 4).
 set -euo pipefail
 
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"

@@ -20,7 +20,7 @@
 # environment: SIZE (default 1024x1024, the paper's), ITERATIONS per level (default 4),
 #   EARTH (earth-mantle resolution, default 432, the paper's finest), MIXER (default 260, the
 #   paper's), PRECISIONS (default "fp16 fp32"), DATA (default data)
-# At the defaults the whole run takes about 15 minutes on 2 cores and 11 GB of memory (the earth
+# At the defaults the whole run takes about 8 minutes on 2 cores and 6 GB of memory (the earth
 # mantle at 432^3 in fp32); EARTH=216 MIXER=130 runs in 2.5 minutes.
 set -euo pipefail
 

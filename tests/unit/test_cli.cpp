@@ -43,6 +43,22 @@ std::string lastLine(const std::string& text) {
   return pos == std::string::npos ? t : t.substr(pos + 1);
 }
 
+// A 24^3 float32 raw volume (unit spacing, with its JSON sidecar) whose voxel at distance r from
+// the centre voxel holds valueAt(r).
+template <class ValueAt>
+void writeBallRaw(const std::string& raw, ValueAt valueAt) {
+  std::ofstream f(raw, std::ios::binary);
+  for (int k = 0; k < 24; ++k)
+    for (int j = 0; j < 24; ++j)
+      for (int i = 0; i < 24; ++i) {
+        const float r =
+            std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
+        const float v = valueAt(r);
+        f.write(reinterpret_cast<const char*>(&v), 4);
+      }
+  std::ofstream(raw + ".json") << R"({"dims":[24,24,24],"type":"float32","spacing":[1,1,1]})";
+}
+
 }  // namespace
 
 TEST(Cli, ScenesListsTheDefault) {
@@ -150,18 +166,7 @@ TEST(Cli, OptimizeReportsFallingEnergyAndRisingVisibility) {
 TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
   // A small raw volume: a ball of value 100 in 0; the ball is the context surface (iso 50).
   const std::string raw = tmp("ball.raw");
-  {
-    std::ofstream f(raw, std::ios::binary);
-    for (int k = 0; k < 24; ++k)
-      for (int j = 0; j < 24; ++j)
-        for (int i = 0; i < 24; ++i) {
-          const float r =
-              std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
-          const float v = r < 4.f ? 150.f : (r < 8.f ? 100.f : 0.f);
-          f.write(reinterpret_cast<const char*>(&v), 4);
-        }
-    std::ofstream(raw + ".json") << R"({"dims":[24,24,24],"type":"float32","spacing":[1,1,1]})";
-  }
+  writeBallRaw(raw, [](float r) { return r < 4.f ? 150.f : (r < 8.f ? 100.f : 0.f); });
   std::ofstream(tmp("g.json")) << R"({"points":[[0,0],[120,0],[140,1]]})";
   const std::string out = tmp("ctx.png");
   Result r = run("optimize --volume " + raw + " --importance " + tmp("g.json") +
@@ -194,18 +199,7 @@ TEST(Cli, OptimizeWithContextSurfacesMasksLensAndDeviationView) {
 // importance named in --importance is a usage error naming it, and no image is written.
 TEST(Cli, CompareTakesThePresetImportanceAsOptimizeDoes) {
   const std::string raw = tmp("ct-ball.raw");
-  {
-    std::ofstream f(raw, std::ios::binary);
-    for (int k = 0; k < 24; ++k)
-      for (int j = 0; j < 24; ++j)
-        for (int i = 0; i < 24; ++i) {
-          const float r =
-              std::sqrt(float((i - 12) * (i - 12) + (j - 12) * (j - 12) + (k - 12) * (k - 12)));
-          const float v = r < 4.f ? 700.f : (r < 9.f ? 0.f : -1000.f);
-          f.write(reinterpret_cast<const char*>(&v), 4);
-        }
-    std::ofstream(raw + ".json") << R"({"dims":[24,24,24],"type":"float32","spacing":[1,1,1]})";
-  }
+  writeBallRaw(raw, [](float r) { return r < 4.f ? 700.f : (r < 9.f ? 0.f : -1000.f); });
   const std::string out = tmp("ct-compare.png");
   fs::remove(out);
   Result r = run("compare --volume " + raw +

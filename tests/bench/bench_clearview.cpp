@@ -16,7 +16,7 @@
 #include <memory>
 #include <string>
 
-#include "stream_probe.h"
+#include "stream_counters.h"
 #include "visopt/engine.h"
 #include "visopt/exec.h"
 #include "visopt/transfer_function.h"
@@ -28,11 +28,6 @@ using visopt::ClearViewMeasure;
 using visopt::ClearViewSettings;
 using visopt::Engine;
 using visopt::Precision;
-
-visopt::bench::StreamResult& stream() {
-  static visopt::bench::StreamResult s;
-  return s;
-}
 
 struct Scene {
   std::string name;
@@ -94,10 +89,7 @@ void composite(benchmark::State& state, const std::string& scene, int w, int h,
   state.counters["ns_per_pixel"] =
       benchmark::Counter(pixels * double(state.iterations()) * 1e-9,
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  if (stream().triadGBs > 0)
-    state.counters["frac_triad"] = benchmark::Counter(
-        pixels * kCompositeBytesPerPixel * 1e-9 / stream().triadGBs * double(state.iterations()),
-        benchmark::Counter::kIsRate);
+  visopt::bench::setTriadFraction(state, "frac_triad", pixels * kCompositeBytesPerPixel);
 }
 
 void extract(benchmark::State& state, const std::string& scene, int w, int h, Precision p) {
@@ -182,10 +174,7 @@ int main(int argc, char** argv) {
             ->Unit(benchmark::kMillisecond);
       }
     }
-  const size_t llc = visopt::bench::lastLevelCacheBytes();
-  const size_t arrayBytes = std::clamp<size_t>(2 * llc, size_t(256) << 20, size_t(1) << 30);
-  stream() = visopt::bench::runStreamProbe(arrayBytes, 5);
-  benchmark::AddCustomContext("stream_triad_GBs", std::to_string(stream().triadGBs));
+  visopt::bench::probeSameRunStream();
   benchmark::AddCustomContext("backend", visopt::backendDescription());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -12,18 +12,13 @@
 #include <string>
 
 #include "optimize/multigrid_transfer.h"
-#include "stream_probe.h"
+#include "stream_counters.h"
 #include "visopt/engine.h"
 #include "visopt/scenes.h"
 
 namespace {
 
 using namespace visopt;
-
-bench::StreamResult& stream() {
-  static bench::StreamResult s;
-  return s;
-}
 
 struct Correction {
   GridSpec fine, coarse;
@@ -63,10 +58,7 @@ void BM_CoarseGridCorrection(benchmark::State& state) {
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   // As if every fine voxel were read and written once (fp32; the coarse fields are cache-sized):
   // an upper bound on the bytes, since the fast path skips rows without change.
-  if (stream().triadGBs > 0)
-    state.counters["frac_triad_whole_field"] =
-        benchmark::Counter(double(c.target.size()) * 8.0 * 1e-9 / stream().triadGBs,
-                           benchmark::Counter::kIsIterationInvariantRate);
+  bench::setTriadFraction(state, "frac_triad_whole_field", double(c.target.size()) * 8.0);
 }
 BENCHMARK(BM_CoarseGridCorrection)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
@@ -94,10 +86,7 @@ BENCHMARK(BM_FollowCall)->Unit(benchmark::kMillisecond)->Iterations(30);
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  const size_t llc = bench::lastLevelCacheBytes();
-  stream() =
-      bench::runStreamProbe(std::clamp<size_t>(2 * llc, size_t(256) << 20, size_t(1) << 30), 5);
-  benchmark::AddCustomContext("stream_triad_GBs", std::to_string(stream().triadGBs));
+  bench::probeSameRunStream();
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

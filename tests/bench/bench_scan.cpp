@@ -46,7 +46,7 @@
 #include "kernels/extinction_step.h"
 #include "kernels/visibility_scan_fast.h"
 #include "optimize/scan_skip_grid.h"
-#include "stream_probe.h"
+#include "stream_counters.h"
 #include "visopt/camera.h"
 #include "visopt/exec.h"
 #include "visopt/field.h"
@@ -125,11 +125,6 @@ visopt::FrustumGrid frustumFor(const Case& c, const visopt::GridSpec& grid) {
   return visopt::FrustumGrid::forCamera(cam, c.frustum, c.frustum, bounds, 0, grid.minSpacing());
 }
 
-visopt::bench::StreamResult& stream() {
-  static visopt::bench::StreamResult s;
-  return s;
-}
-
 // Per iteration: ns per item and core (`perItem`, e.g. "ns_cell_core"), the minimum bytes as
 // GB/s and as a fraction of the probe's triad.
 void setRateCounters(benchmark::State& state, const char* perItem, double items, double bytes) {
@@ -138,9 +133,7 @@ void setRateCounters(benchmark::State& state, const char* perItem, double items,
       benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
   state.counters["GBs"] =
       benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  if (stream().triadGBs > 0)
-    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
-                                                benchmark::Counter::kIsIterationInvariantRate);
+  visopt::bench::setTriadFraction(state, "frac", bytes);
 }
 
 template <class K>
@@ -283,16 +276,13 @@ int main(int argc, char** argv) {
             ->MinTime(0.5)
             ->Unit(benchmark::kMillisecond);
       }
-  const size_t llc = visopt::bench::lastLevelCacheBytes();
-  const size_t arrayBytes = std::clamp<size_t>(2 * llc, size_t(256) << 20, size_t(1) << 30);
-  stream() = visopt::bench::runStreamProbe(arrayBytes, 5);
-  benchmark::AddCustomContext("stream_triad_GBs", std::to_string(stream().triadGBs));
-  benchmark::AddCustomContext("stream_copy_GBs", std::to_string(stream().copyGBs));
+  const size_t arrayBytes = visopt::bench::probeSameRunStream();
   benchmark::AddCustomContext("backend", visopt::backendDescription());
   benchmark::RunSpecifiedBenchmarks();
   const visopt::bench::StreamResult after = visopt::bench::runStreamProbe(arrayBytes, 5);
   std::printf("STREAM triad before %.2f GB/s, after %.2f GB/s (copy %.2f / %.2f)\n",
-              stream().triadGBs, after.triadGBs, stream().copyGBs, after.copyGBs);
+              visopt::bench::sameRunStream().triadGBs, after.triadGBs,
+              visopt::bench::sameRunStream().copyGBs, after.copyGBs);
   benchmark::Shutdown();
   return 0;
 }

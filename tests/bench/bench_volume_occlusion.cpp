@@ -19,18 +19,13 @@
 
 #include "core/device_buffer.h"
 #include "render/renderer.h"
-#include "stream_probe.h"
+#include "stream_counters.h"
 #include "visopt/exec.h"
 #include "visopt/scenes.h"
 
 namespace {
 
 using visopt::Precision;
-
-visopt::bench::StreamResult& stream() {
-  static visopt::bench::StreamResult s;
-  return s;
-}
 
 void runCase(benchmark::State& state, int n, Precision precision) {
   visopt::BuiltinScene built = visopt::makeBuiltinScene("shepp-logan", n, precision);
@@ -60,9 +55,7 @@ void runCase(benchmark::State& state, int n, Precision precision) {
   const double bytes = voxels * (3.0 * b + 56.0);
   state.counters["GBs"] =
       benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  if (stream().triadGBs > 0)
-    state.counters["frac"] = benchmark::Counter(bytes * 1e-9 / stream().triadGBs,
-                                                benchmark::Counter::kIsIterationInvariantRate);
+  visopt::bench::setTriadFraction(state, "frac", bytes);
 }
 
 }  // namespace
@@ -79,10 +72,7 @@ int main(int argc, char** argv) {
           ->MinTime(0.5)
           ->Unit(benchmark::kMillisecond);
     }
-  const size_t llc = visopt::bench::lastLevelCacheBytes();
-  const size_t arrayBytes = std::clamp<size_t>(2 * llc, size_t(256) << 20, size_t(1) << 30);
-  stream() = visopt::bench::runStreamProbe(arrayBytes, 5);
-  benchmark::AddCustomContext("stream_triad_GBs", std::to_string(stream().triadGBs));
+  visopt::bench::probeSameRunStream();
   benchmark::AddCustomContext("backend", visopt::backendDescription());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

@@ -234,21 +234,28 @@ struct RayMarchKernel {
     // meets a volume more important than its first surface hit, the ray starts at that volume
     // (the first sample whose g reaches half the ray's maximum, less one step) and everything in
     // front of it is cut away; the surfaces there too. Otherwise the ray is drawn as the base
-    // scene. T_L and the volume's AO of this method see the volume only (transmittance_scan.h,
-    // volume_occlusion.h): a context dropped for the eye would otherwise shadow what it shows.
+    // scene. This method's T_L and volume AO see the volume only (computeLightTransmittance,
+    // computeVolumeOcclusion): a context dropped for the eye would otherwise shadow what it shows.
     if (method == RayMethod::MaxImportance && t1 > t0) {
       const int count = int(ceilf((t1 - t0) / p.step));
       const float seg = (t1 - t0) / float(count);
       const float offset = p.jitter ? hashToUnit(uint32_t(pixel) * 9781u + p.seed * 6271u) : 0.5f;
+      auto importanceAt = [&](int s) {
+        return p.surf.importance.sample(o + (t0 + (float(s) + offset) * seg) * d);
+      };
       float maxG = 0.f;
-      for (int s = 0; s < count; ++s)
-        maxG = fmaxf(maxG, p.surf.importance.sample(o + (t0 + (float(s) + offset) * seg) * d));
+      int argMax = 0;
+      for (int s = 0; s < count; ++s) {
+        const float g = importanceAt(s);
+        if (g > maxG) {
+          maxG = g;
+          argMax = s;
+        }
+      }
       const float surfaceG = hit.hit ? p.surf.importance.sample(o + hit.t * d) : 0.f;
       if (maxG > kMipMinImportance && maxG > surfaceG) {
-        int first = 0;
-        while (first < count &&
-               p.surf.importance.sample(o + (t0 + (float(first) + offset) * seg) * d) < 0.5f * maxG)
-          ++first;
+        int first = 0;  // at most argMax, where g is the maximum
+        while (first < argMax && importanceAt(first) < 0.5f * maxG) ++first;
         const float start = t0 + float(first > 0 ? first - 1 : 0) * seg;
         if (hit.hit && hit.t < start) {
           // Leave the cut surfaces' interior, then look for a surface beyond the start.

@@ -1,0 +1,255 @@
+// The per-pixel kernels of moment images (Rapp et al. 2022): generation (§3.2: march the ray,
+// accumulate the bounded trigonometric moments of the density and its bounds, rescale by Eq. 5),
+// the moment count of §3.5, and emission-absorption rendering from a density source (the
+// reconstruction of §3.3, or the volume itself as the reference), with a pre-integrated
+// transfer function. Written once for host and device.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "core/hd.h"
+#include "kernels/bounded_mese.h"
+#include "kernels/ray_box.h"
+
+namespace visopt {
+
+// A pixel's ray in the volume's index space and its interval [t0, t1] (world units along the
+// unit direction) inside the box of voxel centres; row 0 is the image's top.
+struct MomentRay {
+  glm::vec3 o{0.f}, d{0.f};
+  float t0 = 0.f, t1 = -1.f;
+  VISOPT_HD bool hits() const { return t1 > t0; }
+};
+
+VISOPT_HD inline MomentRay momentRay(const FrustumMap& camera, const GridMap& volume,
+                                     int64_t pixel) {
+  const int w = camera.dims.x, h = camera.dims.y;
+  const int px = int(pixel % w), row = int(pixel / w);
+  MomentRay r;
+  r.o = volume.toIndex(camera.eye);
+  r.d = volume.directionToIndex(camera.rayDirection(float(px), float(h - 1 - row)));
+  const RayInterval box = intersectBox(r.o, r.d, glm::vec3(volume.dims - 1));
+  r.t0 = box.t0;
+  r.t1 = box.t1;
+  return r;
+}
+
+// Samples on [t0, t1] at most `step` apart, at least two.
+VISOPT_HD inline int momentSampleCount(const MomentRay& r, float step) {
+  const float n = ceilf((r.t1 - r.t0) / step);
+  return n < 1.f ? 2 : (n > 1e6f ? 1000001 : int(n) + 1);
+}
+
+struct MomentGeneration {
+  FrustumMap camera;
+  GridMap volume;
+  FieldView density;  // normalised to [0, 1]
+  int order = 0;      // m
+  float step = 1.f;   // world units
+  float margin = 0.005f;
+  float* moments = nullptr;  // (order + 1) per pixel, rescaled by Eq. 5
+  float* lower = nullptr;    // per pixel; lower > upper marks a ray that misses the volume
+  float* upper = nullptr;
+  int* samples = nullptr;  // per pixel
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const int stride = order + 1;
+    float* out = moments + pixel * stride;
+    const MomentRay r = momentRay(camera, volume, pixel);
+    if (!r.hits()) {
+      for (int j = 0; j < stride; ++j) out[j] = 0.f;
+      lower[pixel] = 1.f;
+      upper[pixel] = 0.f;
+      samples[pixel] = 0;
+      return;
+    }
+    const int n = momentSampleCount(r, step);
+    double c[kMomentCapacity];
+    for (int j = 0; j < stride; ++j) c[j] = 0.0;
+    // In pieces of kPiece samples sharing their end samples (moments of pieces add).
+    constexpr int kPiece = 64;
+    float phi[kPiece + 1], s[kPiece + 1];
+    float lo = 1e30f, hi = -1e30f;
+    const float dt = (r.t1 - r.t0) / float(n - 1);
+    const float dphi = float(kMomentPi) / float(n - 1);
+    for (int start = 0; start < n - 1; start += kPiece) {
+      const int end = start + kPiece < n - 1 ? start + kPiece : n - 1;
+      for (int k = start; k <= end; ++k) {
+        const float v = density.sample(r.o + (r.t0 + float(k) * dt) * r.d);
+        const float sv = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
+        phi[k - start] = k == n - 1 ? 0.f : -float(kMomentPi) + float(k) * dphi;
+        s[k - start] = sv;
+        lo = sv < lo ? sv : lo;
+        hi = sv > hi ? sv : hi;
+      }
+      addSegmentMoments(phi, s, end - start + 1, order, c);
+    }
+    // Eq. 5: the moments of (s - lower) / (upper - lower).
+    const double a = double(lo) - double(margin), b = double(hi) + double(margin);
+    const double scale = 1.0 / (b - a);
+    out[0] = float((c[0] - a) * scale);
+    for (int j = 1; j < stride; ++j) out[j] = float(c[j] * scale);
+    lower[pixel] = float(a);
+    upper[pixel] = float(b);
+    samples[pixel] = n;
+  }
+};
+
+// §3.5: how many moments each pixel keeps (0 for a ray that misses the volume), from the
+// moments as they are stored (floats), capped where the sequence stops being valid.
+struct MomentCount {
+  const float* moments = nullptr;
+  const float* lower = nullptr;
+  const float* upper = nullptr;
+  int order = 0;
+  double threshold = 0.01;
+  uint8_t* counts = nullptr;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    if (!(lower[pixel] < upper[pixel])) {
+      counts[pixel] = 0;
+      return;
+    }
+    double c[kMomentCapacity];
+    for (int j = 0; j <= order; ++j) c[j] = double(moments[pixel * (order + 1) + j]);
+    MomentComplex gamma[kMomentCapacity], q[kMomentCapacity];
+    exponentialMoments(c, order, gamma);
+    const int valid = levinson(gamma, order, q);
+    int n = momentCountFor(c, order, threshold);
+    n = n < valid ? n : valid;
+    counts[pixel] = uint8_t((n < 0 ? 0 : n) + 1);
+  }
+};
+
+// Pre-integration tables of a baked transfer function (rgb albedo, extinction per entry):
+// cumulative integrals over the table's index of the extinction and of albedo x extinction.
+struct MomentTransfer {
+  const glm::vec4* table = nullptr;       // albedo rgb, extinction
+  const glm::vec4* cumulative = nullptr;  // integral of albedo x extinction, of extinction
+  int size = 0;
+  bool preintegrate = true;
+
+  VISOPT_HD glm::vec4 lerp(const glm::vec4* t, float x) const {
+    const int i0 = int(x);
+    const int i1 = i0 + 1 < size ? i0 + 1 : size - 1;
+    const float f = x - float(i0);
+    return t[i0] + f * (t[i1] - t[i0]);
+  }
+
+  // Emitted colour (rgb) and opacity (w) of a segment of `length` world units over which the
+  // normalised density runs linearly from sf to sb.
+  VISOPT_HD glm::vec4 segment(float sf, float sb, float length) const {
+    const float hiX = float(size - 1);
+    const float xf = (sf < 0.f ? 0.f : (sf > 1.f ? 1.f : sf)) * hiX;
+    const float xb = (sb < 0.f ? 0.f : (sb > 1.f ? 1.f : sb)) * hiX;
+    glm::vec3 emitted;  // integral of albedo x extinction over the segment
+    float tau;          // optical depth
+    if (preintegrate && fabsf(xb - xf) > 1e-3f) {
+      const glm::vec4 d = (lerp(cumulative, xb) - lerp(cumulative, xf)) * (length / (xb - xf));
+      emitted = glm::vec3(d);
+      tau = d.w;
+    } else {
+      const glm::vec4 e = lerp(table, preintegrate ? xf : 0.5f * (xf + xb));
+      tau = e.w * length;
+      emitted = glm::vec3(e) * tau;
+    }
+    if (!(tau > 1e-12f)) return glm::vec4(0.f);
+    const float alpha = 1.f - expf(-tau);
+    return glm::vec4(emitted * (alpha / tau), alpha);
+  }
+};
+
+// The density of a pixel's ray from its stored moments (bounded MESE or Fourier), per sample.
+struct MomentDensity {
+  const float* moments = nullptr;  // the pixel's rescaled moments or Lagrange multipliers
+  const float* imag = nullptr;     // the multipliers' imaginary parts (MESE), else null
+  int order = -1;                  // highest index stored
+  float lower = 0.f, upper = 1.f;
+
+  VISOPT_HD float at(float phi) const {
+    if (order < 0) return 0.f;
+    const float st = imag ? meseAt(moments, imag, order, phi) : fourierAt(moments, order, phi);
+    return lower + st * (upper - lower);  // Eq. 5 inverted
+  }
+};
+
+// Front-to-back emission-absorption along one ray, `n` samples from t0 to t1, density(k, t,
+// phi) giving the normalised density at sample k.
+template <class Density>
+VISOPT_HD inline glm::vec3 compositeRay(const MomentRay& r, int n, const MomentTransfer& tf,
+                                        Density density) {
+  const float dt = (r.t1 - r.t0) / float(n - 1);
+  const float dphi = float(kMomentPi) / float(n - 1);
+  glm::vec3 radiance(0.f);
+  float transmittance = 1.f;
+  float front = density(r.t0, -float(kMomentPi));
+  for (int k = 1; k < n && transmittance > 1e-4f; ++k) {
+    const float back = density(r.t0 + float(k) * dt, -float(kMomentPi) + float(k) * dphi);
+    const glm::vec4 seg = tf.segment(front, back, dt);
+    radiance += transmittance * glm::vec3(seg);
+    transmittance *= 1.f - seg.w;
+    front = back;
+  }
+  return radiance;
+}
+
+// Renders pixels from a moment image: per pixel the stored moments (Fourier) or the Lagrange
+// multipliers computed from them (MESE, `imag` set).
+struct MomentRender {
+  FrustumMap camera;
+  GridMap volume;
+  MomentTransfer tf;
+  float step = 1.f;
+  const uint64_t* offsets = nullptr;
+  const float* values = nullptr;  // moments or multipliers' real parts, at offsets
+  const float* imag = nullptr;    // multipliers' imaginary parts, or null (Fourier)
+  const float* lower = nullptr;
+  const float* upper = nullptr;
+  glm::vec3* out = nullptr;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const MomentRay r = momentRay(camera, volume, pixel);
+    const uint64_t begin = offsets[pixel], count = offsets[pixel + 1] - begin;
+    if (!r.hits() || count == 0) {
+      out[pixel] = glm::vec3(0.f);
+      return;
+    }
+    MomentDensity d;
+    d.moments = values + begin;
+    d.imag = imag ? imag + begin : nullptr;
+    d.order = int(count) - 1;
+    d.lower = lower[pixel];
+    d.upper = upper[pixel];
+    out[pixel] = compositeRay(r, momentSampleCount(r, step), tf,
+                              [&](float, float phi) { return d.at(phi); });
+  }
+};
+
+// The same rendering from the volume (the reference).
+struct VolumeEmissionAbsorption {
+  FrustumMap camera;
+  GridMap volume;
+  FieldView density;
+  MomentTransfer tf;
+  float step = 1.f;
+  glm::vec3* out = nullptr;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const MomentRay r = momentRay(camera, volume, pixel);
+    if (!r.hits()) {
+      out[pixel] = glm::vec3(0.f);
+      return;
+    }
+    out[pixel] = compositeRay(r, momentSampleCount(r, step), tf, [&](float t, float) {
+      const float v = density.sample(r.o + t * r.d);
+      return v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
+    });
+  }
+};
+
+}  // namespace visopt

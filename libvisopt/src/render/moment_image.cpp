@@ -1,0 +1,305 @@
+// Moment images (Rapp et al. 2022): generation, the per-pixel moment count, the Lagrange
+// multipliers, and rendering (kernels/moment_image.h), launched on the active backend.
+#include "visopt/moment_image.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/device_buffer.h"
+#include "core/field_view.h"
+#include "core/frustum_map.h"
+#include "exec/parallel.h"
+#include "kernels/moment_image.h"
+#include "visopt/error.h"
+#include "visopt/frustum.h"
+
+namespace visopt {
+
+static_assert(kMaxMomentOrder + 1 <= kMomentCapacity);
+
+namespace {
+
+double msSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+FrustumMap cameraMap(const Camera& camera, int width, int height, const GridSpec& grid) {
+  // Only the rays matter here (FrustumMap::rayDirection): the depth range is unused.
+  return FrustumMap(
+      FrustumGrid::forCamera(camera, width, height, grid.worldBounds(), 1, grid.minSpacing()));
+}
+
+void checkStep(float stepVoxels, const char* what) {
+  if (!(stepVoxels >= 0.01f && stepVoxels <= 16.f))
+    throw Error(ErrorKind::Usage, std::string(what) + " must be within 0.01..16 voxels, got " +
+                                      std::to_string(stepVoxels));
+}
+
+// The transfer function baked over the volume's value range, with its cumulative integrals over
+// the table index (trapezoids) for pre-integration.
+struct BakedTransfer {
+  DeviceBuffer<glm::vec4> table, cumulative;
+  MomentTransfer view(bool preintegrate) const {
+    return MomentTransfer{table.data(), cumulative.data(), int(table.size()), preintegrate};
+  }
+};
+
+BakedTransfer bakeTransfer(const TransferFunction& tf, double valueMin, double valueMax,
+                           float minSpacing) {
+  const TransferTable baked = tf.bake(valueMin, valueMax, minSpacing, 1024);
+  BakedTransfer out{DeviceBuffer<glm::vec4>(baked.albedoExtinction.size()),
+                    DeviceBuffer<glm::vec4>(baked.albedoExtinction.size())};
+  glm::dvec4 sum(0.0);
+  for (size_t i = 0; i < baked.albedoExtinction.size(); ++i) {
+    const glm::vec4 e = baked.albedoExtinction[i];
+    out.table[i] = e;
+    if (i > 0) {
+      const glm::vec4 p = baked.albedoExtinction[i - 1];
+      const glm::dvec4 a(glm::dvec3(glm::vec3(p)) * double(p.w), double(p.w));
+      const glm::dvec4 b(glm::dvec3(glm::vec3(e)) * double(e.w), double(e.w));
+      sum += 0.5 * (a + b);
+    }
+    out.cumulative[i] = glm::vec4(sum);
+  }
+  return out;
+}
+
+Image toImage(const DeviceBuffer<glm::vec3>& pixels, int width, int height) {
+  Image image(width, height);
+  std::copy(pixels.data(), pixels.data() + pixels.size(), image.pixels.begin());
+  return image;
+}
+
+}  // namespace
+
+const char* toString(MomentReconstruction r) {
+  return r == MomentReconstruction::BoundedMese ? "mese" : "fourier";
+}
+
+void checkMomentImageSettings(const MomentImageSettings& s) {
+  if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
+    throw Error(ErrorKind::Usage,
+                "moment image size must be within 1..16384 pixels per side, got " +
+                    std::to_string(s.width) + "x" + std::to_string(s.height));
+  if (s.moments < 0 || s.moments > kMaxMomentOrder)
+    throw Error(ErrorKind::Usage, "moments must be within 0.." + std::to_string(kMaxMomentOrder) +
+                                      ", got " + std::to_string(s.moments));
+  if (!(s.errorThreshold >= 0.f && s.errorThreshold <= 1.f))
+    throw Error(ErrorKind::Usage, "moment error threshold must be within 0..1");
+  if (!(s.boundsMargin > 0.f && s.boundsMargin <= 0.5f))
+    throw Error(ErrorKind::Usage, "moment bounds margin must be within (0, 0.5]");
+  checkStep(s.stepVoxels, "moment generation step");
+}
+
+std::vector<uint64_t> MomentImage::offsets() const {
+  std::vector<uint64_t> out(pixelCount() + 1, 0);
+  for (size_t p = 0; p < pixelCount(); ++p) out[p + 1] = out[p] + counts[p];
+  return out;
+}
+
+MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
+                                const MomentImageSettings& settings, MomentGenerationStats* stats) {
+  checkMomentImageSettings(settings);
+  const GridSpec& grid = volume.grid();
+  checkCamera(camera, grid.worldBounds(), "moment image camera");
+  const size_t pixels = size_t(settings.width) * size_t(settings.height);
+  const int stride = settings.moments + 1;
+  DeviceBuffer<float> dense(pixels * size_t(stride)), lower(pixels), upper(pixels);
+  DeviceBuffer<int> samples(pixels);
+  DeviceBuffer<uint8_t> counts(pixels);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  MomentGeneration gen;
+  gen.camera = cameraMap(camera, settings.width, settings.height, grid);
+  gen.volume = GridMap(grid);
+  gen.density = FieldView(volume.normalized);
+  gen.order = settings.moments;
+  gen.step = settings.stepVoxels * grid.minSpacing();
+  gen.margin = settings.boundsMargin;
+  gen.moments = dense.data();
+  gen.lower = lower.data();
+  gen.upper = upper.data();
+  gen.samples = samples.data();
+  exec::parallelFor("moments: generate", int64_t(pixels), gen);
+  const double marchMs = msSince(t0);
+
+  const auto t1 = std::chrono::steady_clock::now();
+  exec::parallelFor("moments: count", int64_t(pixels),
+                    MomentCount{dense.data(), lower.data(), upper.data(), settings.moments,
+                                double(settings.errorThreshold), counts.data()});
+  const double countMs = msSince(t1);
+
+  MomentImage out;
+  out.width = settings.width;
+  out.height = settings.height;
+  out.order = settings.moments;
+  out.camera = camera;
+  out.grid = grid;
+  out.valueMin = volume.valueMin;
+  out.valueMax = volume.valueMax;
+  out.boundsMargin = settings.boundsMargin;
+  out.errorThreshold = settings.errorThreshold;
+  out.stepVoxels = settings.stepVoxels;
+  out.counts.assign(counts.data(), counts.data() + pixels);
+  out.lower.assign(lower.data(), lower.data() + pixels);
+  out.upper.assign(upper.data(), upper.data() + pixels);
+  int64_t hit = 0, stored = 0, taken = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    stored += out.counts[p];
+    hit += out.counts[p] > 0;
+    taken += samples[p];
+    if (out.counts[p] == 0) out.lower[p] = out.upper[p] = 0.f;
+  }
+  out.moments.reserve(size_t(stored));
+  for (size_t p = 0; p < pixels; ++p)
+    out.moments.insert(out.moments.end(), dense.data() + p * stride,
+                       dense.data() + p * stride + out.counts[p]);
+  if (stats) {
+    stats->marchMs = marchMs;
+    stats->countMs = countMs;
+    stats->samples = taken;
+    stats->meanMoments = hit > 0 ? double(stored) / double(hit) : 0.0;
+  }
+  return out;
+}
+
+namespace {
+
+// The Lagrange multipliers of every pixel's stored moments (§3.3: computed once on loading),
+// real and imaginary parts at the pixel's offsets. A pixel whose higher moments do not form a
+// valid sequence (quantization could do that; float storage rarely) keeps the valid prefix: its
+// unused multipliers are zero.
+struct LagrangeOfPixels {
+  const uint64_t* offsets = nullptr;
+  const float* moments = nullptr;
+  float* re = nullptr;
+  float* im = nullptr;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const uint64_t begin = offsets[pixel];
+    const int count = int(offsets[pixel + 1] - begin);
+    if (count == 0) return;
+    double c[kMomentCapacity] = {};
+    for (int j = 0; j < count; ++j) c[j] = double(moments[begin + j]);
+    MomentComplex lambda[kMomentCapacity];
+    const int order = boundedMese(c, count - 1, lambda);
+    for (int j = 0; j < count; ++j) {
+      re[begin + j] = j <= order ? float(lambda[j].re) : 0.f;
+      im[begin + j] = j <= order ? float(lambda[j].im) : 0.f;
+    }
+    // c_0 outside (0, 1) cannot be: Eq. 5 puts the mean strictly inside the bounds. Should it
+    // happen, the constant with that mean (atan(tan(...)) form of lambda_0) is what remains.
+    if (order < 0) re[begin] = float(tan(kMomentPi * (fmin(fmax(c[0], 1e-6), 1.0 - 1e-6) - 0.5)));
+  }
+};
+
+}  // namespace
+
+Image renderMomentImage(const MomentImage& image, const TransferFunction& tf,
+                        const MomentRenderSettings& settings) {
+  checkStep(settings.stepVoxels, "moment render step");
+  const size_t pixels = image.pixelCount();
+  const std::vector<uint64_t> offsets = image.offsets();
+  DeviceBuffer<uint64_t> off(offsets.size());
+  std::copy(offsets.begin(), offsets.end(), off.data());
+  const size_t stored = image.moments.size();
+  DeviceBuffer<float> values(std::max<size_t>(stored, 1)), imag;
+  DeviceBuffer<float> lower(pixels), upper(pixels);
+  std::copy(image.lower.begin(), image.lower.end(), lower.data());
+  std::copy(image.upper.begin(), image.upper.end(), upper.data());
+  if (settings.reconstruction == MomentReconstruction::BoundedMese) {
+    DeviceBuffer<float> moments(std::max<size_t>(stored, 1));
+    std::copy(image.moments.begin(), image.moments.end(), moments.data());
+    imag = DeviceBuffer<float>(std::max<size_t>(stored, 1));
+    exec::parallelFor("moments: lagrange multipliers", int64_t(pixels),
+                      LagrangeOfPixels{off.data(), moments.data(), values.data(), imag.data()});
+  } else {
+    std::copy(image.moments.begin(), image.moments.end(), values.data());
+  }
+  const BakedTransfer baked =
+      bakeTransfer(tf, image.valueMin, image.valueMax, image.grid.minSpacing());
+  DeviceBuffer<glm::vec3> out(pixels);
+  MomentRender k;
+  k.camera = cameraMap(image.camera, image.width, image.height, image.grid);
+  k.volume = GridMap(image.grid);
+  k.tf = baked.view(settings.preintegrate);
+  k.step = settings.stepVoxels * image.grid.minSpacing();
+  k.offsets = off.data();
+  k.values = values.data();
+  k.imag = settings.reconstruction == MomentReconstruction::BoundedMese ? imag.data() : nullptr;
+  k.lower = lower.data();
+  k.upper = upper.data();
+  k.out = out.data();
+  exec::parallelFor("moments: render", int64_t(pixels), k);
+  return toImage(out, image.width, image.height);
+}
+
+Image renderVolumeEmissionAbsorption(const Volume& volume, const Camera& camera, int width,
+                                     int height, const TransferFunction& tf,
+                                     const MomentRenderSettings& settings) {
+  checkStep(settings.stepVoxels, "render step");
+  const GridSpec& grid = volume.grid();
+  checkCamera(camera, grid.worldBounds(), "camera");
+  const BakedTransfer baked = bakeTransfer(tf, volume.valueMin, volume.valueMax, grid.minSpacing());
+  DeviceBuffer<glm::vec3> out(size_t(width) * size_t(height));
+  VolumeEmissionAbsorption k;
+  k.camera = cameraMap(camera, width, height, grid);
+  k.volume = GridMap(grid);
+  k.density = FieldView(volume.normalized);
+  k.tf = baked.view(settings.preintegrate);
+  k.step = settings.stepVoxels * grid.minSpacing();
+  k.out = out.data();
+  exec::parallelFor("moments: direct render", int64_t(out.size()), k);
+  return toImage(out, width, height);
+}
+
+namespace {
+
+int64_t pixelOf(const MomentImage& image, int x, int y) {
+  if (x < 0 || y < 0 || x >= image.width || y >= image.height)
+    throw Error(ErrorKind::Usage, "pixel (" + std::to_string(x) + ", " + std::to_string(y) +
+                                      ") is outside the moment image");
+  return int64_t(y) * image.width + x;
+}
+
+}  // namespace
+
+std::vector<float> reconstructRay(const MomentImage& image, int x, int y, int samples,
+                                  MomentReconstruction r) {
+  const int64_t p = pixelOf(image, x, y);
+  const std::vector<uint64_t> offsets = image.offsets();
+  const int count = int(offsets[p + 1] - offsets[p]);
+  std::vector<float> out(size_t(std::max(samples, 0)), 0.f);
+  if (count == 0 || samples < 2) return out;
+  std::vector<float> re(count), im(count);
+  const float* c = image.moments.data() + offsets[p];
+  if (r == MomentReconstruction::BoundedMese) {
+    const uint64_t one[2] = {0, uint64_t(count)};  // this pixel alone
+    LagrangeOfPixels{one, c, re.data(), im.data()}(0);
+  } else {
+    std::copy(c, c + count, re.begin());
+  }
+  MomentDensity d{re.data(), r == MomentReconstruction::BoundedMese ? im.data() : nullptr,
+                  count - 1, image.lower[p], image.upper[p]};
+  for (int k = 0; k < samples; ++k)
+    out[k] = d.at(-float(kMomentPi) + float(kMomentPi) * float(k) / float(samples - 1));
+  return out;
+}
+
+std::vector<float> sampleRay(const Volume& volume, const MomentImage& image, int x, int y,
+                             int samples) {
+  const int64_t p = pixelOf(image, x, y);
+  const MomentRay r = momentRay(cameraMap(image.camera, image.width, image.height, image.grid),
+                                GridMap(image.grid), p);
+  std::vector<float> out(size_t(std::max(samples, 0)), 0.f);
+  if (!r.hits() || samples < 2) return out;
+  const FieldView density(volume.normalized);
+  for (int k = 0; k < samples; ++k) {
+    const float t = r.t0 + (r.t1 - r.t0) * float(k) / float(samples - 1);
+    out[k] = std::clamp(density.sample(r.o + t * r.d), 0.f, 1.f);
+  }
+  return out;
+}
+
+}  // namespace visopt

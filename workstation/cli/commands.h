@@ -18,5 +18,6 @@ Runner addCompareCommand(CLI::App& app);
 Runner addSdfCommand(CLI::App& app);
 Runner addSessionInfoCommand(CLI::App& app);
 Runner addImageDiffCommand(CLI::App& app);
+Runner addMomentsCommand(CLI::App& app);
 
 }  // namespace visopt::cli

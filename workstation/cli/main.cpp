@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
   add(addSdfCommand, "sdf", "Convert a triangle mesh to a signed distance field (.vdb)");
   add(addSessionInfoCommand, "session-info", "Describe a session file and check its data files");
   add(addImageDiffCommand, "image-diff", "PSNR, SSIM and FLIP of two images of the same size");
+  add(addMomentsCommand, "moments",
+      "Moment images (Rapp et al. 2022): generate, render with any transfer function, info");
 
   try {
     app.parse(argc, argv);

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "cli_common.h"
 #include "commands.h"
@@ -106,7 +107,9 @@ Runner addMomentsCommand(CLI::App& app) {
   CLI::App* ren = app.add_subcommand("render", "Render a moment image with a transfer function");
   ren->add_option("file", r->file, "Moment image (.vmi)")->required();
   ren->add_option("--tf", r->tf, "Transfer function: a JSON file or preset:NAME")
-      ->default_str("preset:generic over the image's value range");
+      ->default_str(
+          "that of --volume/--scene when given, else preset:generic over the image's "
+          "value range");
   ren->add_option("--reconstruction", r->reconstruction, "mese (bounded MESE) or fourier")
       ->capture_default_str();
   ren->add_option("--step", r->settings.stepVoxels,
@@ -190,11 +193,23 @@ Runner addMomentsCommand(CLI::App& app) {
       const auto t0 = std::chrono::steady_clock::now();
       const MomentImage image = readMomentImage(r->file);
       const double readMs = msSince(t0);
+      // The volume or scene the image was made from, when given: its own transfer function is
+      // the default, and its direct rendering the comparison.
+      std::optional<Engine> source;
+      if (!r->volume.empty() || !r->scene.empty()) {
+        source.emplace(Precision::FP32);
+        loadInput(*source, r->volume, r->scene, r->resolution, false);
+        if (!(source->volume().grid() == image.grid))
+          throw Error(ErrorKind::Usage,
+                      "the volume's grid is not the one " + r->file + " was generated from");
+      }
       Volume range;  // the value range a preset such as generic spans
       range.valueMin = image.valueMin;
       range.valueMax = image.valueMax;
-      const TransferFunction tf =
-          loadTransferFunction(r->tf.empty() ? std::string("preset:generic") : r->tf, range);
+      const TransferFunction tf = !r->tf.empty()
+                                      ? loadTransferFunction(r->tf, range)
+                                      : (source ? source->transferFunction()
+                                                : loadTransferFunction("preset:generic", range));
       const auto t1 = std::chrono::steady_clock::now();
       const Image out = renderMomentImage(image, tf, r->settings);
       const double renderMs = msSince(t1);
@@ -204,15 +219,10 @@ Runner addMomentsCommand(CLI::App& app) {
                           {"reconstruction", toString(r->settings.reconstruction)},
                           {"preintegration", r->settings.preintegrate},
                           {"times_ms", {{"read", readMs}, {"render", renderMs}}}};
-      if (!r->volume.empty() || !r->scene.empty()) {
-        Engine engine(Precision::FP32);
-        loadInput(engine, r->volume, r->scene, r->resolution, false);
-        if (!(engine.volume().grid() == image.grid))
-          throw Error(ErrorKind::Usage,
-                      "the volume's grid is not the one " + r->file + " was generated from");
+      if (source) {
         const auto t2 = std::chrono::steady_clock::now();
         const Image direct = renderVolumeEmissionAbsorption(
-            engine.volume(), image.camera, image.width, image.height, tf, r->settings);
+            source->volume(), image.camera, image.width, image.height, tf, r->settings);
         d["times_ms"]["direct_render"] = msSince(t2);
         d["psnr_against_direct_db"] = psnr(out, direct);
         if (!r->referenceOut.empty()) writePng(direct, r->referenceOut);

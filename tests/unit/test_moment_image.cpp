@@ -4,6 +4,7 @@
 // of a thin feature, and the .vmi file with what a broken one must not do.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +14,7 @@
 
 #include "core/frustum_map.h"
 #include "kernels/moment_image.h"
+#include "kernels/p_square.h"
 #include "visopt/error.h"
 #include "visopt/frustum.h"
 #include "visopt/moment_image.h"
@@ -221,6 +223,70 @@ TEST(MomentImage, PreintegrationCatchesAThinFeatureAtACoarseStep) {
   EXPECT_GT(std::abs(mid - ref), 0.5f * ref);  // midpoint samples miss or overweight it
 }
 
+TEST(PSquare, EstimatesAQuantileOfALongSequenceAndIsExactForFewValues) {
+  // Exact order statistics up to five values.
+  PSquare few(0.5f);
+  for (float v : {5.f, 1.f, 3.f}) few.add(v);
+  EXPECT_EQ(few.value(), 3.f);
+  // A deterministic pseudo-random sequence: the estimate against the sorted values.
+  for (float p : {0.5f, 0.9f, 0.95f}) {
+    PSquare q(p);
+    std::vector<float> values;
+    uint32_t state = 12345u;
+    for (int i = 0; i < 5000; ++i) {
+      state = state * 1664525u + 1013904223u;
+      const float u = float(state >> 8) / float(1u << 24);
+      const float v = u * u;  // skewed, like errors
+      values.push_back(v);
+      q.add(v);
+    }
+    std::sort(values.begin(), values.end());
+    const float exact = values[size_t(p * float(values.size() - 1))];
+    EXPECT_NEAR(q.value(), exact, 0.01f) << "p=" << p;
+  }
+}
+
+TEST(MomentImage, TheUncertaintyIsTheErrorQuantileAlongTheRayAndFallsWithMoreMoments) {
+  const BuiltinScene s = scene();
+  MomentImageSettings settings = small(60, 0.1f);
+  settings.uncertaintyQuantile = 0.9f;
+  const MomentImage coarse = generateMomentImage(s.volume, viewOf(s), settings);
+  settings.errorThreshold = 0.f;
+  const MomentImage fine = generateMomentImage(s.volume, viewOf(s), settings);
+  ASSERT_EQ(coarse.uncertainty.size(), coarse.pixelCount());
+  double meanCoarse = 0.0, meanFine = 0.0;
+  int hit = 0;
+  for (size_t p = 0; p < coarse.pixelCount(); ++p) {
+    if (coarse.counts[p] == 0) {
+      EXPECT_EQ(coarse.uncertainty[p], 0.f);
+      continue;
+    }
+    meanCoarse += coarse.uncertainty[p];
+    meanFine += fine.uncertainty[p];
+    ++hit;
+  }
+  EXPECT_LT(meanFine, meanCoarse);
+  // One pixel against the exact quantile of its reconstruction's errors.
+  const int x = 20, y = 16;
+  const int64_t p = int64_t(y) * coarse.width + x;
+  const std::vector<uint64_t> offsets = coarse.offsets();
+  const MomentRay r = momentRay(
+      FrustumMap(FrustumGrid::forCamera(coarse.camera, coarse.width, coarse.height,
+                                        coarse.grid.worldBounds(), 1, coarse.grid.minSpacing())),
+      GridMap(coarse.grid), p);
+  const int n = momentSampleCount(r, coarse.stepVoxels * coarse.grid.minSpacing());
+  const std::vector<float> truth = sampleRay(s.volume, coarse, x, y, n);
+  const std::vector<float> rec = reconstructRay(coarse, x, y, n, MomentReconstruction::BoundedMese);
+  std::vector<float> errors;
+  for (int k = 0; k < n; ++k) errors.push_back(std::abs(rec[k] - truth[k]));
+  std::sort(errors.begin(), errors.end());
+  const float exact = errors[size_t(0.9 * (n - 1))];
+  EXPECT_NEAR(coarse.uncertainty[p], exact, 0.2f * exact + 1e-3f);
+  const Image heat = renderMomentUncertainty(coarse);
+  EXPECT_EQ(heat.width, coarse.width);
+  EXPECT_THROW(renderMomentUncertainty(generateMomentImage(s.volume, viewOf(s), small(10))), Error);
+}
+
 // --- the .vmi file -------------------------------------------------------------------------
 
 std::string tmpPath(const char* name) {
@@ -250,7 +316,9 @@ std::string refusal(const std::string& path) {
 
 TEST(MomentImageFile, RoundTripsBitForBit) {
   const BuiltinScene s = scene();
-  const MomentImage image = generateMomentImage(s.volume, viewOf(s), small(40, 0.01f));
+  MomentImageSettings settings = small(40, 0.01f);
+  settings.uncertaintyQuantile = 0.95f;
+  const MomentImage image = generateMomentImage(s.volume, viewOf(s), settings);
   const std::string path = tmpPath("round.vmi");
   writeMomentImage(image, path);
   const MomentImage back = readMomentImage(path);
@@ -264,6 +332,8 @@ TEST(MomentImageFile, RoundTripsBitForBit) {
   EXPECT_EQ(back.lower, image.lower);
   EXPECT_EQ(back.upper, image.upper);
   EXPECT_EQ(back.moments, image.moments);
+  EXPECT_EQ(back.uncertaintyQuantile, 0.95f);
+  EXPECT_EQ(back.uncertainty, image.uncertainty);
 }
 
 TEST(MomentImageFile, BrokenFilesAreRefusedNamingTheFileAndTheProblem) {

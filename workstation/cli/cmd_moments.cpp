@@ -1,6 +1,7 @@
 // visopt moments generate | render | info: moment images (Rapp, Peters, Dachsbacher 2022). A
 // moment image holds, per pixel of a fixed view, the bounded trigonometric moments of the
 // density along the pixel's ray; any transfer function can then be applied without the volume.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -67,7 +68,8 @@ Runner addMomentsCommand(CLI::App& app) {
     std::string file, tf, out, reconstruction = "mese", volume, scene, referenceOut;
     int resolution = 128;
     MomentRenderSettings settings;
-    bool noPreintegration = false, json = false;
+    bool noPreintegration = false, uncertainty = false, json = false;
+    float uncertaintyMax = 0.f;
   };
   struct Info {
     std::string file;
@@ -101,6 +103,10 @@ Runner addMomentsCommand(CLI::App& app) {
   gen->add_option("--step", g->settings.stepVoxels,
                   "Ray-march step in units of the smallest voxel spacing")
       ->capture_default_str();
+  gen->add_option("--uncertainty", g->settings.uncertaintyQuantile,
+                  "Also store per pixel this quantile of the reconstruction's error along the "
+                  "ray (§4.1; a second march; 0: none), e.g. 0.95")
+      ->capture_default_str();
   gen->add_option("--out", g->out, "Output .vmi file")->required();
   gen->add_flag("--json", g->json, "Print per-stage times and sizes as JSON");
 
@@ -118,6 +124,11 @@ Runner addMomentsCommand(CLI::App& app) {
   ren->add_flag("--no-preintegration", r->noPreintegration,
                 "Sample each segment at its midpoint instead of the pre-integrated transfer "
                 "function");
+  ren->add_flag("--uncertainty", r->uncertainty,
+                "Draw the stored error quantile (§4.1) as a magma heat map instead");
+  ren->add_option("--uncertainty-max", r->uncertaintyMax,
+                  "Error (normalised density) at the top of the heat map; 0: the image's largest")
+      ->capture_default_str();
   ren->add_option("--out", r->out, "Output PNG")->required();
   CLI::Option* refVolume = ren->add_option(
       "--volume", r->volume, "The volume the image was made from: also render it directly");
@@ -165,6 +176,7 @@ Runner addMomentsCommand(CLI::App& app) {
         d["times_ms"] = {{"load", loadMs},
                          {"march", stats.marchMs},
                          {"count", stats.countMs},
+                         {"uncertainty", stats.uncertaintyMs},
                          {"write", writeMs}};
         d["samples"] = stats.samples;
         d["stages"] = stageTimingsJson();
@@ -193,6 +205,21 @@ Runner addMomentsCommand(CLI::App& app) {
       const auto t0 = std::chrono::steady_clock::now();
       const MomentImage image = readMomentImage(r->file);
       const double readMs = msSince(t0);
+      if (r->uncertainty) {
+        if (image.uncertainty.empty())
+          throw Error(ErrorKind::Usage, r->file +
+                                            " holds no uncertainty (generate it with "
+                                            "--uncertainty Q)");
+        float top = r->uncertaintyMax;
+        if (!(top > 0.f))
+          for (float e : image.uncertainty) top = std::max(top, e);
+        writePng(renderMomentUncertainty(image, top), r->out);
+        std::printf(
+            "%s: the %g quantile of the reconstruction error along each ray, 0 (black "
+            "in magma) to %g (yellow) in normalised density\n",
+            r->out.c_str(), double(image.uncertaintyQuantile), double(top));
+        return int(kOk);
+      }
       // The volume or scene the image was made from, when given: its own transfer function is
       // the default, and its direct rendering the comparison.
       std::optional<Engine> source;

@@ -31,6 +31,9 @@ struct MomentImageSettings {
                                  // of all m + 1; 0 keeps all of them
   float boundsMargin = 0.005f;   // epsilon of §3.2: the bounds are [min - eps, max + eps]
   float stepVoxels = 0.5f;       // ray-march step, in units of the smallest voxel spacing
+  // §4.1: when in (0, 1), a second march stores per pixel this quantile of the reconstruction's
+  // error along the ray (|bounded MESE - volume| in normalised density); 0: none.
+  float uncertaintyQuantile = 0.f;
 };
 
 // Throws Error(Usage) naming the setting when one is out of range.
@@ -49,6 +52,9 @@ struct MomentImage {
   std::vector<float> lower, upper;
   // The rescaled moments c^t of Eq. 5 of every pixel, pixel after pixel.
   std::vector<float> moments;
+  // §4.1, when generated: per pixel the uncertaintyQuantile of the error along the ray.
+  float uncertaintyQuantile = 0.f;
+  std::vector<float> uncertainty;
 
   size_t pixelCount() const { return size_t(width) * size_t(height); }
   // Start of each pixel's moments in `moments` (pixelCount() + 1 entries).
@@ -59,6 +65,7 @@ struct MomentGenerationStats {
   double marchMs = 0.0, countMs = 0.0;  // ray marching with moment accumulation; §3.5's counts
   int64_t samples = 0;                  // density samples taken
   double meanMoments = 0.0;             // stored moments per pixel hit by the volume
+  double uncertaintyMs = 0.0;           // §4.1's second march, when asked for
 };
 
 MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
@@ -87,6 +94,11 @@ Image renderVolumeEmissionAbsorption(const Volume& volume, const Camera& camera,
                                      int height, const TransferFunction& tf,
                                      const MomentRenderSettings& settings);
 
+// §4.1's uncertainty as a heat map (visopt/colormap.h's magma from 0 to `maxError`; 0 takes the
+// image's largest value); black where the ray misses the volume. Throws Error(Usage) when the
+// image holds no uncertainty.
+Image renderMomentUncertainty(const MomentImage& image, float maxError = 0.f);
+
 // The normalised density along pixel (x, y)'s ray at `samples` points from t0 to t1: from the
 // moment image, and from the volume (the ground truth of §5.2's sample PSNR).
 std::vector<float> reconstructRay(const MomentImage& image, int x, int y, int samples,
@@ -95,10 +107,10 @@ std::vector<float> sampleRay(const Volume& volume, const MomentImage& image, int
                              int samples);
 
 // The .vmi file, version 1: little-endian, a header block and the counts, bounds and moments
-// blocks, each with its length and CRC-32. Writing is atomic. Reading refuses, naming the file,
-// a wrong magic or version, a truncated file, a block whose checksum or length is wrong, counts
-// above the order, bounds that are not finite or not increasing, and a header claiming more
-// pixels or moments than the file holds.
+// blocks (and the uncertainty block when there is one), each with its length and CRC-32. Writing is
+// atomic. Reading refuses, naming the file, a wrong magic or version, a truncated file, a block
+// whose checksum or length is wrong, counts above the order, bounds that are not finite or not
+// increasing, and a header claiming more pixels or moments than the file holds.
 void writeMomentImage(const MomentImage& image, const std::string& path);
 MomentImage readMomentImage(const std::string& path);
 

@@ -7,6 +7,7 @@
 //   "CNTS": u8 per pixel, the moments stored (0..order + 1).
 //   "BNDS": f32 lower, upper per pixel.
 //   "MOMS": f32 moments, pixel after pixel (as many as the counts add up to).
+//   "UNCT" (only when the block count is 5): f32 quantile in (0, 1), then f32 per pixel.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -25,7 +26,7 @@ namespace {
 
 constexpr char kMagic[8] = {'V', 'I', 'S', 'O', 'P', 'T', 'M', 'I'};
 constexpr uint32_t kVersion = 1;
-constexpr uint32_t kBlocks = 4;
+constexpr uint32_t kBlocks = 4;  // 5 with the uncertainty block
 
 class Writer {
  public:
@@ -126,14 +127,23 @@ void writeMomentImage(const MomentImage& image, const std::string& path) {
   Writer moments;
   moments.put(image.moments.data(), image.moments.size() * sizeof(float));
 
+  const bool uncertain = !image.uncertainty.empty();
+  if (uncertain && image.uncertainty.size() != pixels)
+    throw Error(ErrorKind::Usage, "moment image: the uncertainty does not match its size");
   Writer file;
   file.put(kMagic, 8);
   file.put(kVersion);
-  file.put(kBlocks);
+  file.put(kBlocks + (uncertain ? 1u : 0u));
   putBlock(file, "HEAD", std::move(head.bytes()));
   putBlock(file, "CNTS", std::vector<unsigned char>(image.counts.begin(), image.counts.end()));
   putBlock(file, "BNDS", std::move(bounds.bytes()));
   putBlock(file, "MOMS", std::move(moments.bytes()));
+  if (uncertain) {
+    Writer u;
+    u.put(image.uncertaintyQuantile);
+    u.put(image.uncertainty.data(), pixels * sizeof(float));
+    putBlock(file, "UNCT", std::move(u.bytes()));
+  }
 
   const std::string tmp = io::makeTemporarySibling(path, ".vmi");
   try {
@@ -167,8 +177,9 @@ MomentImage readMomentImage(const std::string& path) {
   if (version != kVersion)
     throwBadInput(path, "moment image version " + std::to_string(version) +
                             " is not supported (this visopt reads version 1)");
-  if (file.get<uint32_t>("the block count") != kBlocks)
-    throwBadInput(path, "wrong block count (a version 1 file has 4 blocks)");
+  const uint32_t blocks = file.get<uint32_t>("the block count");
+  if (blocks != kBlocks && blocks != kBlocks + 1)
+    throwBadInput(path, "wrong block count (a version 1 file has 4 or 5 blocks)");
   auto block = [&](const char* tag) {
     const unsigned char* t = file.take(4, "a block tag");
     if (std::memcmp(t, tag, 4) != 0)
@@ -268,6 +279,20 @@ MomentImage readMomentImage(const std::string& path) {
     for (size_t i = 0; i < stored; ++i)
       if (!std::isfinite(image.moments[i]))
         throwBadInput(path, "moment " + std::to_string(i) + " is not finite");
+  }
+  if (blocks == kBlocks + 1) {
+    Reader u = block("UNCT");
+    if (u.left() != 4 + pixels * 4)
+      throwBadInput(path, "the uncertainty block does not hold one float per pixel");
+    image.uncertaintyQuantile = u.get<float>("the uncertainty");
+    if (!(image.uncertaintyQuantile > 0.f && image.uncertaintyQuantile < 1.f))
+      throwBadInput(path, "the uncertainty quantile is outside (0, 1)");
+    image.uncertainty.resize(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+      image.uncertainty[p] = u.get<float>("the uncertainty");
+      if (!(image.uncertainty[p] >= 0.f && image.uncertainty[p] <= 1.f))
+        throwBadInput(path, "pixel " + std::to_string(p) + "'s uncertainty is outside [0, 1]");
+    }
   }
   if (file.left() != 0) throwBadInput(path, "unexpected bytes after the last block");
   return image;

@@ -14,6 +14,7 @@
 #include "core/frustum_map.h"
 #include "core/hd.h"
 #include "kernels/bounded_mese.h"
+#include "kernels/p_square.h"
 #include "kernels/ray_box.h"
 
 namespace visopt {
@@ -249,6 +250,52 @@ struct VolumeEmissionAbsorption {
       const float v = density.sample(r.o + t * r.d);
       return v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
     });
+  }
+};
+
+// §4.1: per pixel, the p-quantile of |reconstructed - volume| density along the ray (bounded
+// MESE of the stored moments against the volume's samples at the generation's step), estimated
+// online by P-square so that a pixel needs no storage of its samples.
+struct MomentUncertainty {
+  FrustumMap camera;
+  GridMap volume;
+  FieldView density;
+  float step = 1.f;
+  float quantile = 0.95f;
+  const uint64_t* offsets = nullptr;
+  const float* moments = nullptr;
+  const float* lower = nullptr;
+  const float* upper = nullptr;
+  float* out = nullptr;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const MomentRay r = momentRay(camera, volume, pixel);
+    const uint64_t begin = offsets[pixel];
+    const int count = int(offsets[pixel + 1] - begin);
+    if (!r.hits() || count == 0) {
+      out[pixel] = 0.f;
+      return;
+    }
+    double c[kMomentCapacity] = {};
+    for (int j = 0; j < count; ++j) c[j] = double(moments[begin + j]);
+    MomentComplex lambda[kMomentCapacity];
+    const int order = boundedMese(c, count - 1, lambda);
+    float re[kMomentCapacity], im[kMomentCapacity];
+    for (int j = 0; j <= (order < 0 ? 0 : order); ++j) {
+      re[j] = order < 0 ? 0.f : float(lambda[j].re);
+      im[j] = order < 0 ? 0.f : float(lambda[j].im);
+    }
+    const MomentDensity d{re, im, order < 0 ? 0 : order, lower[pixel], upper[pixel]};
+    const int n = momentSampleCount(r, step);
+    const float dt = (r.t1 - r.t0) / float(n - 1);
+    const float dphi = float(kMomentPi) / float(n - 1);
+    PSquare q(quantile);
+    for (int k = 0; k < n; ++k) {
+      const float v = density.sample(r.o + (r.t0 + float(k) * dt) * r.d);
+      const float truth = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
+      q.add(fabsf(d.at(-float(kMomentPi) + float(k) * dphi) - truth));
+    }
+    out[pixel] = q.value();
   }
 };
 

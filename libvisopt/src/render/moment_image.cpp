@@ -11,6 +11,7 @@
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
 #include "kernels/moment_image.h"
+#include "visopt/colormap.h"
 #include "visopt/error.h"
 #include "visopt/frustum.h"
 
@@ -90,6 +91,8 @@ void checkMomentImageSettings(const MomentImageSettings& s) {
   if (!(s.boundsMargin > 0.f && s.boundsMargin <= 0.5f))
     throw Error(ErrorKind::Usage, "moment bounds margin must be within (0, 0.5]");
   checkStep(s.stepVoxels, "moment generation step");
+  if (!(s.uncertaintyQuantile >= 0.f && s.uncertaintyQuantile < 1.f))
+    throw Error(ErrorKind::Usage, "uncertainty quantile must be within [0, 1) (0: none)");
 }
 
 std::vector<uint64_t> MomentImage::offsets() const {
@@ -155,6 +158,21 @@ MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
   for (size_t p = 0; p < pixels; ++p)
     out.moments.insert(out.moments.end(), dense.data() + p * stride,
                        dense.data() + p * stride + out.counts[p]);
+  if (settings.uncertaintyQuantile > 0.f) {
+    const auto t2 = std::chrono::steady_clock::now();
+    const std::vector<uint64_t> offsets = out.offsets();
+    DeviceBuffer<uint64_t> off(offsets.size());
+    std::copy(offsets.begin(), offsets.end(), off.data());
+    DeviceBuffer<float> kept(std::max<size_t>(out.moments.size(), 1)), error(pixels);
+    std::copy(out.moments.begin(), out.moments.end(), kept.data());
+    exec::parallelFor("moments: uncertainty", int64_t(pixels),
+                      MomentUncertainty{gen.camera, gen.volume, gen.density, gen.step,
+                                        settings.uncertaintyQuantile, off.data(), kept.data(),
+                                        lower.data(), upper.data(), error.data()});
+    out.uncertaintyQuantile = settings.uncertaintyQuantile;
+    out.uncertainty.assign(error.data(), error.data() + pixels);
+    if (stats) stats->uncertaintyMs = msSince(t2);
+  }
   if (stats) {
     stats->marchMs = marchMs;
     stats->countMs = countMs;
@@ -252,6 +270,23 @@ Image renderVolumeEmissionAbsorption(const Volume& volume, const Camera& camera,
   k.out = out.data();
   exec::parallelFor("moments: direct render", int64_t(out.size()), k);
   return toImage(out, width, height);
+}
+
+Image renderMomentUncertainty(const MomentImage& image, float maxError) {
+  if (image.uncertainty.size() != image.pixelCount())
+    throw Error(ErrorKind::Usage,
+                "the moment image holds no uncertainty (generate it with an uncertainty quantile)");
+  float top = maxError;
+  if (!(top > 0.f))
+    for (float e : image.uncertainty) top = std::max(top, e);
+  Image out(image.width, image.height);
+  for (size_t p = 0; p < image.pixelCount(); ++p)
+    out.pixels[p] =
+        image.counts[p] == 0
+            ? glm::vec3(0.f)
+            : evaluateColormap(Colormap::Magma,
+                               top > 0.f ? std::min(image.uncertainty[p] / top, 1.f) : 0.f);
+  return out;
 }
 
 namespace {

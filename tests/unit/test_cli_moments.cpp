@@ -50,6 +50,18 @@ TEST(CliMoments, GenerateInfoAndRenderAgainstTheDirectRendering) {
     EXPECT_GT(j["psnr_against_direct_db"].get<double>(), 30.0) << rec;
     EXPECT_TRUE(fs::exists(png));
   }
+  // Without an uncertainty block, --uncertainty is a usage error; with one it draws the heat map.
+  r = run("moments render " + vmi + " --uncertainty --out " + tmp("u.png"));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("holds no uncertainty"), std::string::npos) << r.err;
+  const std::string withU = tmp("ml-u.vmi");
+  ASSERT_EQ(run("moments generate --scene builtin:marschner-lobb --resolution 32 --size 24x20 "
+                "--moments 30 --uncertainty 0.9 --out " + withU)
+                .code,
+            0);
+  r = run("moments render " + withU + " --uncertainty --out " + tmp("u.png"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(tmp("u.png")));
   // The direct rendering needs the same grid: another resolution is refused.
   r = run("moments render " + vmi + " --scene builtin:marschner-lobb --resolution 40 --out " +
           tmp("x.png"));

@@ -1,0 +1,113 @@
+// Moment images (Rapp et al. 2022; docs/moment-images.md): generation (the march with moment
+// accumulation, then §3.5's count) and rendering with the bounded MESE and the Fourier series,
+// against the direct emission-absorption march of the volume with the same transfer function and
+// step, per scene and image size; the same-run STREAM probe gives the memory system's pace.
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <string>
+
+#include "stream_counters.h"
+#include "visopt/exec.h"
+#include "visopt/moment_image.h"
+#include "visopt/scenes.h"
+
+namespace {
+
+using namespace visopt;
+
+struct Case {
+  std::string scene;
+  int resolution;
+};
+
+const BuiltinScene& sceneOf(const Case& c) {
+  static std::map<std::string, BuiltinScene> cache;
+  auto it = cache.find(c.scene);
+  if (it == cache.end())
+    it = cache.emplace(c.scene, makeBuiltinScene(c.scene, c.resolution, Precision::FP32)).first;
+  return it->second;
+}
+
+Camera viewOf(const BuiltinScene& s) {
+  return Camera::orbitBounds(s.volume.grid().worldBounds(), s.azimuthDeg, s.elevationDeg,
+                             s.distanceInRadii);
+}
+
+void generate(benchmark::State& state, const Case& c, int size) {
+  const BuiltinScene& s = sceneOf(c);
+  MomentImageSettings settings;
+  settings.width = settings.height = size;
+  MomentGenerationStats stats;
+  double march = 0.0, count = 0.0;
+  int64_t samples = 0;
+  for (auto _ : state) {
+    const MomentImage image = generateMomentImage(s.volume, viewOf(s), settings, &stats);
+    benchmark::DoNotOptimize(image.moments.data());
+    march += stats.marchMs;
+    count += stats.countMs;
+    samples += stats.samples;
+    state.counters["moments_per_hit_pixel"] = stats.meanMoments;
+  }
+  const double n = double(state.iterations());
+  state.counters["march_ms"] = march / n;
+  state.counters["count_ms"] = count / n;
+  state.counters["ns_per_sample_march"] = march * 1e6 / double(samples);
+}
+
+void render(benchmark::State& state, const Case& c, int size, MomentReconstruction r) {
+  const BuiltinScene& s = sceneOf(c);
+  MomentImageSettings settings;
+  settings.width = settings.height = size;
+  const MomentImage image = generateMomentImage(s.volume, viewOf(s), settings);
+  MomentRenderSettings rs;
+  rs.reconstruction = r;
+  for (auto _ : state) benchmark::DoNotOptimize(renderMomentImage(image, s.transferFunction, rs));
+  state.counters["ns_per_pixel"] =
+      benchmark::Counter(double(image.pixelCount()), benchmark::Counter::kIsIterationInvariantRate |
+                                                         benchmark::Counter::kInvert);
+  visopt::bench::setTriadFraction(state, "moment_bytes_of_triad",
+                                  double(image.moments.size()) * 4.0);
+}
+
+void direct(benchmark::State& state, const Case& c, int size) {
+  const BuiltinScene& s = sceneOf(c);
+  const MomentRenderSettings rs;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(
+        renderVolumeEmissionAbsorption(s.volume, viewOf(s), size, size, s.transferFunction, rs));
+  state.counters["ns_per_pixel"] =
+      benchmark::Counter(double(size) * size, benchmark::Counter::kIsIterationInvariantRate |
+                                                  benchmark::Counter::kInvert);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  const Case cases[] = {{"marschner-lobb", 64}, {"shepp-logan", 128}};
+  for (const Case& c : cases)
+    for (int size : {256, 512}) {
+      const std::string name = c.scene + "/" + std::to_string(size);
+      benchmark::RegisterBenchmark(("generate/" + name).c_str(),
+                                   [=](benchmark::State& st) { generate(st, c, size); })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+      for (MomentReconstruction r :
+           {MomentReconstruction::BoundedMese, MomentReconstruction::Fourier})
+        benchmark::RegisterBenchmark(("render-" + std::string(toString(r)) + "/" + name).c_str(),
+                                     [=](benchmark::State& st) { render(st, c, size, r); })
+            ->UseRealTime()
+            ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("render-direct/" + name).c_str(),
+                                   [=](benchmark::State& st) { direct(st, c, size); })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+    }
+  visopt::bench::probeSameRunStream();
+  benchmark::AddCustomContext("backend", visopt::backendDescription());
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

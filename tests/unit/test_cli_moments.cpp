@@ -56,7 +56,8 @@ TEST(CliMoments, GenerateInfoAndRenderAgainstTheDirectRendering) {
   EXPECT_NE(r.err.find("holds no uncertainty"), std::string::npos) << r.err;
   const std::string withU = tmp("ml-u.vmi");
   ASSERT_EQ(run("moments generate --scene builtin:marschner-lobb --resolution 32 --size 24x20 "
-                "--moments 30 --uncertainty 0.9 --out " + withU)
+                "--moments 30 --uncertainty 0.9 --out " +
+                withU)
                 .code,
             0);
   r = run("moments render " + withU + " --uncertainty --out " + tmp("u.png"));

@@ -174,9 +174,5 @@ int main(int argc, char** argv) {
             ->Unit(benchmark::kMillisecond);
       }
     }
-  visopt::bench::probeSameRunStream();
-  benchmark::AddCustomContext("backend", visopt::backendDescription());
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return visopt::bench::runWithSameRunStream();
 }

@@ -105,9 +105,5 @@ int main(int argc, char** argv) {
           ->UseRealTime()
           ->Unit(benchmark::kMillisecond);
     }
-  visopt::bench::probeSameRunStream();
-  benchmark::AddCustomContext("backend", visopt::backendDescription());
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return visopt::bench::runWithSameRunStream();
 }

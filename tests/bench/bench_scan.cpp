@@ -276,13 +276,5 @@ int main(int argc, char** argv) {
             ->MinTime(0.5)
             ->Unit(benchmark::kMillisecond);
       }
-  const size_t arrayBytes = visopt::bench::probeSameRunStream();
-  benchmark::AddCustomContext("backend", visopt::backendDescription());
-  benchmark::RunSpecifiedBenchmarks();
-  const visopt::bench::StreamResult after = visopt::bench::runStreamProbe(arrayBytes, 5);
-  std::printf("STREAM triad before %.2f GB/s, after %.2f GB/s (copy %.2f / %.2f)\n",
-              visopt::bench::sameRunStream().triadGBs, after.triadGBs,
-              visopt::bench::sameRunStream().copyGBs, after.copyGBs);
-  benchmark::Shutdown();
-  return 0;
+  return visopt::bench::runWithSameRunStream(/*probeAfter=*/true);
 }

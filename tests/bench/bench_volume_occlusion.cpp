@@ -72,9 +72,5 @@ int main(int argc, char** argv) {
           ->MinTime(0.5)
           ->Unit(benchmark::kMillisecond);
     }
-  visopt::bench::probeSameRunStream();
-  benchmark::AddCustomContext("backend", visopt::backendDescription());
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return visopt::bench::runWithSameRunStream();
 }

@@ -5,11 +5,13 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 
 #include <benchmark/benchmark.h>
 
 #include "stream_probe.h"
+#include "visopt/exec.h"
 
 namespace visopt::bench {
 
@@ -38,6 +40,22 @@ inline void setTriadFraction(benchmark::State& state, const std::string& name,
   if (sameRunStream().triadGBs > 0)
     state.counters[name] = benchmark::Counter(bytesPerIteration * 1e-9 / sameRunStream().triadGBs,
                                               benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// The tail of a benchmark main: the same-run STREAM probe and the backend in the context, the
+// registered cases, and with probeAfter a second probe whose rates are printed beside the first
+// (a drop says the cases ran on a machine that got busier). Returns main's exit status.
+inline int runWithSameRunStream(bool probeAfter = false) {
+  const size_t arrayBytes = probeSameRunStream();
+  benchmark::AddCustomContext("backend", backendDescription());
+  benchmark::RunSpecifiedBenchmarks();
+  if (probeAfter) {
+    const StreamResult after = runStreamProbe(arrayBytes, 5);
+    std::printf("STREAM triad before %.2f GB/s, after %.2f GB/s (copy %.2f / %.2f)\n",
+                sameRunStream().triadGBs, after.triadGBs, sameRunStream().copyGBs, after.copyGBs);
+  }
+  benchmark::Shutdown();
+  return 0;
 }
 
 }  // namespace visopt::bench

@@ -54,19 +54,34 @@ void printSummary(const nlohmann::json& d) {
       d["bytes_all_moments_fp32"].get<double>() / 1024.0);
 }
 
+// --volume / --scene / --resolution: the volume or built-in scene a subcommand reads.
+struct Input {
+  std::string volume, scene;
+  int resolution = 128;
+};
+
+void addInputOptions(CLI::App& app, Input& in, const std::string& volumeHelp,
+                     const std::string& sceneHelp) {
+  CLI::Option* volume = app.add_option("--volume", in.volume, volumeHelp);
+  CLI::Option* scene = app.add_option("--scene", in.scene, sceneHelp);
+  volume->excludes(scene);
+  app.add_option("--resolution", in.resolution, "Built-in scene resolution (longest axis)")
+      ->capture_default_str();
+}
+
 }  // namespace
 
 Runner addMomentsCommand(CLI::App& app) {
   app.require_subcommand(1);
   struct Generate {
-    std::string volume, scene, camera, size = "512x512", out;
-    int resolution = 128;
+    Input input;
+    std::string camera, size = "512x512", out;
     MomentImageSettings settings;
     bool json = false;
   };
   struct Render {
-    std::string file, tf, out, reconstruction = "mese", volume, scene, referenceOut;
-    int resolution = 128;
+    Input input;
+    std::string file, tf, out, reconstruction = "mese", referenceOut;
     MomentRenderSettings settings;
     bool noPreintegration = false, uncertainty = false, json = false;
     float uncertaintyMax = 0.f;
@@ -80,12 +95,8 @@ Runner addMomentsCommand(CLI::App& app) {
   auto i = std::make_shared<Info>();
 
   CLI::App* gen = app.add_subcommand("generate", "March a volume and write its moment image");
-  CLI::Option* volumeOption = gen->add_option("--volume", g->volume, "Volume file or DICOM folder");
-  CLI::Option* sceneOption =
-      gen->add_option("--scene", g->scene, "Built-in scene, builtin:NAME (see `visopt scenes`)");
-  volumeOption->excludes(sceneOption);
-  gen->add_option("--resolution", g->resolution, "Built-in scene resolution (longest axis)")
-      ->capture_default_str();
+  addInputOptions(*gen, g->input, "Volume file or DICOM folder",
+                  "Built-in scene, builtin:NAME (see `visopt scenes`)");
   gen->add_option("--camera", g->camera,
                   "Orbit AZ,EL,DIST: degrees about +z, degrees above the xy-plane, distance in "
                   "bounding-sphere radii")
@@ -130,13 +141,8 @@ Runner addMomentsCommand(CLI::App& app) {
                   "Error (normalised density) at the top of the heat map; 0: the image's largest")
       ->capture_default_str();
   ren->add_option("--out", r->out, "Output PNG")->required();
-  CLI::Option* refVolume = ren->add_option(
-      "--volume", r->volume, "The volume the image was made from: also render it directly");
-  CLI::Option* refScene =
-      ren->add_option("--scene", r->scene, "The built-in scene the image was made from");
-  refVolume->excludes(refScene);
-  ren->add_option("--resolution", r->resolution, "Built-in scene resolution")
-      ->capture_default_str();
+  addInputOptions(*ren, r->input, "The volume the image was made from: also render it directly",
+                  "The built-in scene the image was made from");
   ren->add_option("--reference-out", r->referenceOut,
                   "PNG of the direct rendering of --volume/--scene (same view, transfer function "
                   "and step); its PSNR against the moment image's rendering is printed");
@@ -157,7 +163,7 @@ Runner addMomentsCommand(CLI::App& app) {
       checkMomentImageSettings(g->settings);
       const auto t0 = std::chrono::steady_clock::now();
       Engine engine(Precision::FP32);
-      loadInput(engine, g->volume, g->scene, g->resolution, !g->json);
+      loadInput(engine, g->input.volume, g->input.scene, g->input.resolution, !g->json);
       const double loadMs = msSince(t0);
       if (!g->camera.empty()) {
         const glm::vec3 c = parseTriple(g->camera, "--camera");
@@ -192,7 +198,7 @@ Runner addMomentsCommand(CLI::App& app) {
       resetStageTimings();
       checkPngOutput(r->out);
       if (!r->referenceOut.empty()) checkPngOutput(r->referenceOut);
-      if (!r->referenceOut.empty() && r->volume.empty() && r->scene.empty())
+      if (!r->referenceOut.empty() && r->input.volume.empty() && r->input.scene.empty())
         throw Error(ErrorKind::Usage, "--reference-out needs --volume or --scene");
       if (r->reconstruction == "mese")
         r->settings.reconstruction = MomentReconstruction::BoundedMese;
@@ -210,9 +216,7 @@ Runner addMomentsCommand(CLI::App& app) {
           throw Error(ErrorKind::Usage, r->file +
                                             " holds no uncertainty (generate it with "
                                             "--uncertainty Q)");
-        float top = r->uncertaintyMax;
-        if (!(top > 0.f))
-          for (float e : image.uncertainty) top = std::max(top, e);
+        const float top = uncertaintyHeatMapTop(image, r->uncertaintyMax);
         writePng(renderMomentUncertainty(image, top), r->out);
         std::printf(
             "%s: the %g quantile of the reconstruction error along each ray, 0 (black "
@@ -223,9 +227,9 @@ Runner addMomentsCommand(CLI::App& app) {
       // The volume or scene the image was made from, when given: its own transfer function is
       // the default, and its direct rendering the comparison.
       std::optional<Engine> source;
-      if (!r->volume.empty() || !r->scene.empty()) {
+      if (!r->input.volume.empty() || !r->input.scene.empty()) {
         source.emplace(Precision::FP32);
-        loadInput(*source, r->volume, r->scene, r->resolution, false);
+        loadInput(*source, r->input.volume, r->input.scene, r->input.resolution, false);
         if (!(source->volume().grid() == image.grid))
           throw Error(ErrorKind::Usage,
                       "the volume's grid is not the one " + r->file + " was generated from");

@@ -98,6 +98,8 @@ Image renderVolumeEmissionAbsorption(const Volume& volume, const Camera& camera,
 // image's largest value); black where the ray misses the volume. Throws Error(Usage) when the
 // image holds no uncertainty.
 Image renderMomentUncertainty(const MomentImage& image, float maxError = 0.f);
+// The error at the top of that heat map: maxError when positive, else the image's largest.
+float uncertaintyHeatMapTop(const MomentImage& image, float maxError = 0.f);
 
 // The normalised density along pixel (x, y)'s ray at `samples` points from t0 to t1: from the
 // moment image, and from the volume (the ground truth of §5.2's sample PSNR).

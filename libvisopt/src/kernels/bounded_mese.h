@@ -76,12 +76,19 @@ VISOPT_HD inline MomentComplex exponentialSeed(double c0) {
 
 // Eq. 1: the exponential moments gamma_0..gamma_m of bounded moments c_0..c_m. (The reference
 // code reads gamma_l where the sum needs gamma_j, which puts its round trip 3-17 % off.)
+// The convolution sum_{j=1}^{l-1} (l - j) c_{l-j} gamma_j that Eqs. 1 and 9 share.
+VISOPT_HD inline MomentComplex weightedConvolution(int l, const double* c,
+                                                   const MomentComplex* gamma) {
+  MomentComplex sum{0.0, 0.0};
+  for (int j = 1; j < l; ++j) sum = sum + (double(l - j) * c[l - j]) * gamma[j];
+  return sum;
+}
+
 VISOPT_HD inline void exponentialMoments(const double* c, int m, MomentComplex* gamma) {
   const MomentComplex seed = exponentialSeed(c[0]);
   gamma[0] = {2.0 * seed.re, 0.0};
   for (int l = 1; l <= m; ++l) {
-    MomentComplex sum = (double(l) * c[l]) * seed;
-    for (int j = 1; j < l; ++j) sum = sum + (double(l - j) * c[l - j]) * gamma[j];
+    const MomentComplex sum = (double(l) * c[l]) * seed + weightedConvolution(l, c, gamma);
     // (2 pi i / l) * sum
     const double f = 2.0 * kMomentPi / double(l);
     gamma[l] = {-f * sum.im, f * sum.re};
@@ -93,8 +100,7 @@ VISOPT_HD inline double boundedMomentAt(int l, const MomentComplex* gamma, const
                                         MomentComplex seed) {
   // gamma_l / (2 pi i seed) - sum_{j<l} (l - j) gamma_j c_{l-j} / (l seed)
   const MomentComplex twoPiISeed = {-2.0 * kMomentPi * seed.im, 2.0 * kMomentPi * seed.re};
-  MomentComplex sum{0.0, 0.0};
-  for (int j = 1; j < l; ++j) sum = sum + (double(l - j) * c[l - j]) * gamma[j];
+  const MomentComplex sum = weightedConvolution(l, c, gamma);
   const MomentComplex v = divide(gamma[l], twoPiISeed) -
                           divide(sum, MomentComplex{double(l) * seed.re, double(l) * seed.im});
   return v.re;  // real up to round-off: the signal is even
@@ -190,13 +196,12 @@ VISOPT_HD inline Real fourierAt(const Real* c, int m, Real phi) {
   return c[0] + Real(2) * sum;
 }
 
-// §3.4-3.5: the moments c_{n+1}..c_m of the bounded MESE of c_0..c_n (Eq. 10 extends the
-// exponential moments with the same q, Eq. 9 maps them back), written into c[n+1..m]. Returns
-// false when c_0..c_n do not form a valid sequence.
-VISOPT_HD inline bool extendMoments(double* c, int n, int m) {
-  MomentComplex gamma[kMomentCapacity], q[kMomentCapacity];
+// §3.4-3.5: the moments c_{n+1}..c_m of the bounded MESE of c_0..c_n, given their exponential
+// moments gamma_0..gamma_n (Eq. 10 extends them with the same q into gamma[n+1..m], Eq. 9 maps
+// them back), written into c[n+1..m]. Returns false when c_0..c_n do not form a valid sequence.
+VISOPT_HD inline bool extendMomentsFrom(double* c, MomentComplex* gamma, int n, int m) {
+  MomentComplex q[kMomentCapacity];
   if (!(c[0] > 0.0 && c[0] < 1.0)) return false;
-  exponentialMoments(c, n, gamma);
   const int order = levinson(gamma, n, q);
   if (order < n) return false;
   const MomentComplex seed = exponentialSeed(c[0]);
@@ -211,27 +216,54 @@ VISOPT_HD inline bool extendMoments(double* c, int n, int m) {
   return true;
 }
 
+// The same from c_0..c_n alone.
+VISOPT_HD inline bool extendMoments(double* c, int n, int m) {
+  MomentComplex gamma[kMomentCapacity];
+  if (!(c[0] > 0.0 && c[0] < 1.0)) return false;
+  exponentialMoments(c, n, gamma);
+  return extendMomentsFrom(c, gamma, n, m);
+}
+
 // §3.5's error of keeping c_0..c_n of c_0..c_m: the rRMSE of the dropped moments against those
-// the bounded MESE of the kept ones predicts, relative to c_0. Infinite when the prefix is not
-// a valid sequence.
-VISOPT_HD inline double truncationError(const double* c, int n, int m) {
+// the bounded MESE of the kept ones predicts, relative to c_0, given the exponential moments
+// gamma_0..gamma_n of the prefix. Infinite when the prefix is not a valid sequence.
+VISOPT_HD inline double truncationErrorFrom(const double* c, const MomentComplex* gamma, int n,
+                                            int m) {
   if (n >= m) return 0.0;
   double ext[kMomentCapacity];
-  for (int l = 0; l <= n; ++l) ext[l] = c[l];
-  if (!extendMoments(ext, n, m)) return 1e300;
+  MomentComplex g[kMomentCapacity];
+  for (int l = 0; l <= n; ++l) {
+    ext[l] = c[l];
+    g[l] = gamma[l];
+  }
+  if (!extendMomentsFrom(ext, g, n, m)) return 1e300;
   double sum = 0.0;
   for (int l = n + 1; l <= m; ++l) sum += (c[l] - ext[l]) * (c[l] - ext[l]);
   return sqrt(sum) / c[0];
 }
 
+// The same from c alone (the reference momentCountFor is checked against).
+VISOPT_HD inline double truncationError(const double* c, int n, int m) {
+  if (n >= m) return 0.0;
+  if (!(c[0] > 0.0 && c[0] < 1.0)) return 1e300;
+  MomentComplex gamma[kMomentCapacity];
+  exponentialMoments(c, n, gamma);
+  return truncationErrorFrom(c, gamma, n, m);
+}
+
 // The smallest n whose truncation error is at most `threshold`, by bisection over [0, m] (§3.5);
-// m when threshold <= 0.
+// m when threshold <= 0. Eq. 1 is causal (gamma_l needs c_0..c_l only), so the exponential
+// moments of every prefix the bisection tries are those of the whole sequence, computed once.
 VISOPT_HD inline int momentCountFor(const double* c, int m, double threshold) {
   if (!(threshold > 0.0)) return m;
+  MomentComplex gamma[kMomentCapacity];
+  const bool valid = c[0] > 0.0 && c[0] < 1.0;
+  if (valid) exponentialMoments(c, m, gamma);
   int lo = 0, hi = m;
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (truncationError(c, mid, m) <= threshold)
+    const double e = mid >= m ? 0.0 : (valid ? truncationErrorFrom(c, gamma, mid, m) : 1e300);
+    if (e <= threshold)
       hi = mid;
     else
       lo = mid + 1;

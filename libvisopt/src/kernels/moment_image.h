@@ -253,6 +253,24 @@ struct VolumeEmissionAbsorption {
   }
 };
 
+// The bounded MESE's multipliers lambda_0..lambda_{count-1} of one pixel's `count` moments, as
+// floats (zero past the order used); returns that order. c_0 outside (0, 1) cannot be (Eq. 5
+// puts the mean strictly inside the bounds); should it happen, the constant with that mean
+// (lambda_0 = tan(pi (c_0 - 1/2)), order 0) is what remains.
+VISOPT_HD inline int pixelMultipliers(const float* moments, int count, float* re, float* im) {
+  double c[kMomentCapacity] = {};
+  for (int j = 0; j < count; ++j) c[j] = double(moments[j]);
+  MomentComplex lambda[kMomentCapacity];
+  const int order = boundedMese(c, count - 1, lambda);
+  for (int j = 0; j < count; ++j) {
+    re[j] = j <= order ? float(lambda[j].re) : 0.f;
+    im[j] = j <= order ? float(lambda[j].im) : 0.f;
+  }
+  if (order >= 0) return order;
+  re[0] = float(tan(kMomentPi * (fmin(fmax(c[0], 1e-6), 1.0 - 1e-6) - 0.5)));
+  return 0;
+}
+
 // §4.1: per pixel, the p-quantile of |reconstructed - volume| density along the ray (bounded
 // MESE of the stored moments against the volume's samples at the generation's step), estimated
 // online by P-square so that a pixel needs no storage of its samples.
@@ -276,16 +294,9 @@ struct MomentUncertainty {
       out[pixel] = 0.f;
       return;
     }
-    double c[kMomentCapacity] = {};
-    for (int j = 0; j < count; ++j) c[j] = double(moments[begin + j]);
-    MomentComplex lambda[kMomentCapacity];
-    const int order = boundedMese(c, count - 1, lambda);
     float re[kMomentCapacity], im[kMomentCapacity];
-    for (int j = 0; j <= (order < 0 ? 0 : order); ++j) {
-      re[j] = order < 0 ? 0.f : float(lambda[j].re);
-      im[j] = order < 0 ? 0.f : float(lambda[j].im);
-    }
-    const MomentDensity d{re, im, order < 0 ? 0 : order, lower[pixel], upper[pixel]};
+    const int order = pixelMultipliers(moments + begin, count, re, im);
+    const MomentDensity d{re, im, order, lower[pixel], upper[pixel]};
     const int n = momentSampleCount(r, step);
     const float dt = (r.t1 - r.t0) / float(n - 1);
     const float dphi = float(kMomentPi) / float(n - 1);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 
 #include "core/device_buffer.h"
 #include "core/field_view.h"
@@ -197,18 +198,7 @@ struct LagrangeOfPixels {
   VISOPT_HD void operator()(int64_t pixel) const {
     const uint64_t begin = offsets[pixel];
     const int count = int(offsets[pixel + 1] - begin);
-    if (count == 0) return;
-    double c[kMomentCapacity] = {};
-    for (int j = 0; j < count; ++j) c[j] = double(moments[begin + j]);
-    MomentComplex lambda[kMomentCapacity];
-    const int order = boundedMese(c, count - 1, lambda);
-    for (int j = 0; j < count; ++j) {
-      re[begin + j] = j <= order ? float(lambda[j].re) : 0.f;
-      im[begin + j] = j <= order ? float(lambda[j].im) : 0.f;
-    }
-    // c_0 outside (0, 1) cannot be: Eq. 5 puts the mean strictly inside the bounds. Should it
-    // happen, the constant with that mean (atan(tan(...)) form of lambda_0) is what remains.
-    if (order < 0) re[begin] = float(tan(kMomentPi * (fmin(fmax(c[0], 1e-6), 1.0 - 1e-6) - 0.5)));
+    if (count > 0) pixelMultipliers(moments + begin, count, re + begin, im + begin);
   }
 };
 
@@ -272,13 +262,18 @@ Image renderVolumeEmissionAbsorption(const Volume& volume, const Camera& camera,
   return toImage(out, width, height);
 }
 
+float uncertaintyHeatMapTop(const MomentImage& image, float maxError) {
+  if (maxError > 0.f) return maxError;
+  float top = 0.f;
+  for (float e : image.uncertainty) top = std::max(top, e);
+  return top;
+}
+
 Image renderMomentUncertainty(const MomentImage& image, float maxError) {
   if (image.uncertainty.size() != image.pixelCount())
     throw Error(ErrorKind::Usage,
                 "the moment image holds no uncertainty (generate it with an uncertainty quantile)");
-  float top = maxError;
-  if (!(top > 0.f))
-    for (float e : image.uncertainty) top = std::max(top, e);
+  const float top = uncertaintyHeatMapTop(image, maxError);
   Image out(image.width, image.height);
   for (size_t p = 0; p < image.pixelCount(); ++p)
     out.pixels[p] =
@@ -303,20 +298,21 @@ int64_t pixelOf(const MomentImage& image, int x, int y) {
 std::vector<float> reconstructRay(const MomentImage& image, int x, int y, int samples,
                                   MomentReconstruction r) {
   const int64_t p = pixelOf(image, x, y);
-  const std::vector<uint64_t> offsets = image.offsets();
-  const int count = int(offsets[p + 1] - offsets[p]);
+  // The pixel's first moment: the counts before it (one pixel's query needs no offset table).
+  const uint64_t begin =
+      std::accumulate(image.counts.begin(), image.counts.begin() + p, uint64_t(0));
+  const int count = int(image.counts[size_t(p)]);
   std::vector<float> out(size_t(std::max(samples, 0)), 0.f);
   if (count == 0 || samples < 2) return out;
   std::vector<float> re(count), im(count);
-  const float* c = image.moments.data() + offsets[p];
-  if (r == MomentReconstruction::BoundedMese) {
-    const uint64_t one[2] = {0, uint64_t(count)};  // this pixel alone
-    LagrangeOfPixels{one, c, re.data(), im.data()}(0);
-  } else {
+  const float* c = image.moments.data() + begin;
+  int order = count - 1;
+  if (r == MomentReconstruction::BoundedMese)
+    order = pixelMultipliers(c, count, re.data(), im.data());
+  else
     std::copy(c, c + count, re.begin());
-  }
-  MomentDensity d{re.data(), r == MomentReconstruction::BoundedMese ? im.data() : nullptr,
-                  count - 1, image.lower[p], image.upper[p]};
+  MomentDensity d{re.data(), r == MomentReconstruction::BoundedMese ? im.data() : nullptr, order,
+                  image.lower[p], image.upper[p]};
   for (int k = 0; k < samples; ++k)
     out[k] = d.at(-float(kMomentPi) + float(kMomentPi) * float(k) / float(samples - 1));
   return out;

@@ -564,8 +564,11 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, bo
   const double h = double(L.grid.minSpacing());
   LevelSetSettings chunkSettings = in.levelSet;
   // A chunk is as many substeps as keep the surface's motion under half a voxel at the rate of
-  // the last chunk (at least `substeps`, at most 64 explicit ones), so redistancing runs about once
-  // per half voxel moved rather than after every few substeps of a slow surface.
+  // the last chunk (at least `substeps`, at most 64 explicit ones), and redistancing runs once the
+  // motion bound since the last reaches a voxel (two chunks of a fast surface), rather than after
+  // every few substeps of a slow one. (At half a voxel, the Cranium CT's skin ran redistancing
+  // 6.4 s of a 34.7 s optimisation; at one voxel 3.1 s of 28.8 s with the same V_occ, 0.990, and
+  // a final image 37.5 dB from the other.)
   int chunk = std::max(in.levelSet.substeps, 1);
   if (in.levelSet.semiImplicit && L.semiImplicitChunk > 0) chunk = L.semiImplicitChunk;
   LevelSetStepStats ls;
@@ -604,7 +607,7 @@ void ExtinctionOptimizer::surfaceStep(const OptimizationInputs& in, Level& L, bo
     // pulls voxels a voxel or so outside an opened surface back towards phi0 by ~0.2 voxel per
     // substep while redistancing pushes them out again, which ran redistancing every ten
     // substeps without any surface moving.)
-    if (L.motionSinceRedistance >= 0.5 * h ||
+    if (L.motionSinceRedistance >= 1.0 * h ||
         L.insideRiseSinceRedistance >= double(kNearSurfaceBand) * h) {
       for (size_t si = 0; si < L.phi.size(); ++si) {
         const Field3D& phi0 = L.finest ? *in.surfaceBases[si] : L.phi0[si];

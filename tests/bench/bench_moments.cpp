@@ -55,13 +55,15 @@ void generate(benchmark::State& state, const Case& c, int size) {
   state.counters["ns_per_sample_march"] = march * 1e6 / double(samples);
 }
 
-void render(benchmark::State& state, const Case& c, int size, MomentReconstruction r) {
+void render(benchmark::State& state, const Case& c, int size, MomentReconstruction r,
+            bool perSample = false) {
   const BuiltinScene& s = sceneOf(c);
   MomentImageSettings settings;
   settings.width = settings.height = size;
   const MomentImage image = generateMomentImage(s.volume, viewOf(s), settings);
   MomentRenderSettings rs;
   rs.reconstruction = r;
+  rs.perSampleReference = perSample;
   for (auto _ : state) benchmark::DoNotOptimize(renderMomentImage(image, s.transferFunction, rs));
   state.counters["ns_per_pixel"] =
       benchmark::Counter(double(image.pixelCount()), benchmark::Counter::kIsIterationInvariantRate |
@@ -100,6 +102,13 @@ int main(int argc, char** argv) {
                                      [=](benchmark::State& st) { render(st, c, size, r); })
             ->UseRealTime()
             ->Unit(benchmark::kMillisecond);
+      // The renderer's per-sample reference, for the lanes path's speed-up in the same run.
+      benchmark::RegisterBenchmark(("render-mese-per-sample/" + name).c_str(),
+                                   [=](benchmark::State& st) {
+                                     render(st, c, size, MomentReconstruction::BoundedMese, true);
+                                   })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
       benchmark::RegisterBenchmark(("render-direct/" + name).c_str(),
                                    [=](benchmark::State& st) { direct(st, c, size); })
           ->UseRealTime()

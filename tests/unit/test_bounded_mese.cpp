@@ -329,6 +329,50 @@ TEST(BoundedMese, MomentCountEqualsTheBisectionOverTruncationError) {
   EXPECT_EQ(momentCountFor(empty.data(), m, 0.01), reference(empty.data(), 0.01));
 }
 
+// The renderer evaluates Eq. 3 and the Fourier series kMomentLanes angles at a time; each lane
+// must be the scalar evaluation at its angle (the same operations: equal to float round-off) for
+// the multipliers of real moment sequences of orders 0 to 100.
+TEST(BoundedMese, LaneEvaluationIsTheScalarOneAtEachAngle) {
+  uint32_t state = 777u;
+  auto uniform = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1u << 24);
+  };
+  int compared = 0;
+  for (int m : {0, 1, 2, 7, 16, 35, 64, 100}) {
+    const double centre = -kPi * uniform(), width = 0.2 + uniform();
+    const std::vector<double> c = momentsOfSamples(
+        [&](double p) {
+          const double u = (p - centre) / width;
+          return 0.1 + (std::abs(u) < 1.0 ? 0.7 * 0.5 * (1.0 + std::cos(kPi * u)) : 0.0);
+        },
+        m, 1500);
+    MomentComplex lambda[kMomentCapacity];
+    const int order = boundedMese(c.data(), m, lambda);
+    ASSERT_GE(order, 0) << m;
+    std::vector<float> re(order + 1), im(order + 1), cf(m + 1);
+    for (int l = 0; l <= order; ++l) {
+      re[l] = float(lambda[l].re);
+      im[l] = float(lambda[l].im);
+    }
+    for (int l = 0; l <= m; ++l) cf[l] = float(c[l]);
+    for (int block = 0; block < 8; ++block) {
+      float phi[kMomentLanes], mese[kMomentLanes], fourier[kMomentLanes];
+      for (int i = 0; i < kMomentLanes; ++i) phi[i] = float(-kPi * uniform());
+      meseAtLanes(re.data(), im.data(), order, phi, mese);
+      fourierAtLanes(cf.data(), m, phi, fourier);
+      for (int i = 0; i < kMomentLanes; ++i) {
+        EXPECT_NEAR(mese[i], meseAt(re.data(), im.data(), order, phi[i]), 2e-6f)
+            << "order " << order << " phi " << phi[i];
+        EXPECT_NEAR(fourier[i], fourierAt(cf.data(), m, phi[i]), 2e-6f)
+            << "m " << m << " phi " << phi[i];
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 8 * 8 * kMomentLanes);
+}
+
 TEST(BoundedMese, InvalidMomentsAreRefusedNotReconstructed) {
   std::vector<double> c(5, 0.0);
   c[0] = 1.2;  // the mean of a signal in [0, 1] cannot exceed 1

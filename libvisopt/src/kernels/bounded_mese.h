@@ -181,6 +181,37 @@ VISOPT_HD inline Real meseAt(const Real* lambdaRe, const Real* lambdaIm, int m, 
   return Real(1) / Real(kMomentPi) * momentAtan(lambdaRe[0] + Real(2) * sum) + Real(0.5);
 }
 
+// Rendering evaluates a ray's samples kMomentLanes at a time: meseAt's rotation by exp(-i phi)
+// is a chain of dependent multiplies, m long per sample, so one sample at a time waits on
+// latency; independent samples side by side fill the SIMD lanes (and a GPU thread's pipeline).
+inline constexpr int kMomentLanes = 16;
+
+// meseAt at kMomentLanes angles phi[0..], the same operations lane by lane.
+template <class Real>
+VISOPT_HD inline void meseAtLanes(const Real* lambdaRe, const Real* lambdaIm, int m,
+                                  const Real* phi, Real* out) {
+  Real cr[kMomentLanes], ci[kMomentLanes], zr[kMomentLanes], zi[kMomentLanes], sum[kMomentLanes];
+  for (int i = 0; i < kMomentLanes; ++i) {
+    cr[i] = momentCos(phi[i]);
+    ci[i] = -momentSin(phi[i]);
+    zr[i] = 1;
+    zi[i] = 0;
+    sum[i] = 0;
+  }
+  for (int l = 1; l <= m; ++l) {
+    const Real a = lambdaRe[l], b = lambdaIm[l];
+    VISOPT_LANE_LOOP
+    for (int i = 0; i < kMomentLanes; ++i) {
+      const Real nr = zr[i] * cr[i] - zi[i] * ci[i], ni = zr[i] * ci[i] + zi[i] * cr[i];
+      zr[i] = nr;
+      zi[i] = ni;
+      sum[i] += a * zr[i] - b * zi[i];
+    }
+  }
+  for (int i = 0; i < kMomentLanes; ++i)
+    out[i] = Real(1) / Real(kMomentPi) * momentAtan(lambdaRe[0] + Real(2) * sum[i]) + Real(0.5);
+}
+
 // The truncated Fourier series c_0 + 2 sum_l c_l cos(l phi) (the signal is even).
 template <class Real>
 VISOPT_HD inline Real fourierAt(const Real* c, int m, Real phi) {
@@ -194,6 +225,29 @@ VISOPT_HD inline Real fourierAt(const Real* c, int m, Real phi) {
     cur = next;
   }
   return c[0] + Real(2) * sum;
+}
+
+// fourierAt at kMomentLanes angles phi[0..], the same operations lane by lane.
+template <class Real>
+VISOPT_HD inline void fourierAtLanes(const Real* c, int m, const Real* phi, Real* out) {
+  Real c1[kMomentLanes], prev[kMomentLanes], cur[kMomentLanes], sum[kMomentLanes];
+  for (int i = 0; i < kMomentLanes; ++i) {
+    c1[i] = momentCos(phi[i]);
+    prev[i] = 1;
+    cur[i] = c1[i];
+    sum[i] = 0;
+  }
+  for (int l = 1; l <= m; ++l) {
+    const Real a = c[l];
+    VISOPT_LANE_LOOP
+    for (int i = 0; i < kMomentLanes; ++i) {
+      sum[i] += a * cur[i];
+      const Real next = Real(2) * c1[i] * cur[i] - prev[i];
+      prev[i] = cur[i];
+      cur[i] = next;
+    }
+  }
+  for (int i = 0; i < kMomentLanes; ++i) out[i] = c[0] + Real(2) * sum[i];
 }
 
 // §3.4-3.5: the moments c_{n+1}..c_m of the bounded MESE of c_0..c_n, given their exponential

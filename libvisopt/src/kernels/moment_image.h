@@ -177,6 +177,18 @@ struct MomentDensity {
     const float st = imag ? meseAt(moments, imag, order, phi) : fourierAt(moments, order, phi);
     return lower + st * (upper - lower);  // Eq. 5 inverted
   }
+  // at() at kMomentLanes angles.
+  VISOPT_HD void atLanes(const float* phi, float* out) const {
+    if (order < 0) {
+      for (int i = 0; i < kMomentLanes; ++i) out[i] = 0.f;
+      return;
+    }
+    if (imag)
+      meseAtLanes(moments, imag, order, phi, out);
+    else
+      fourierAtLanes(moments, order, phi, out);
+    for (int i = 0; i < kMomentLanes; ++i) out[i] = lower + out[i] * (upper - lower);
+  }
 };
 
 // Front-to-back emission-absorption along one ray, `n` samples from t0 to t1, density(k, t,
@@ -199,8 +211,42 @@ VISOPT_HD inline glm::vec3 compositeRay(const MomentRay& r, int n, const MomentT
   return radiance;
 }
 
+// compositeRay with the density taken kMomentLanes samples at a time, density(phi, out) giving
+// the normalised density at the angles phi[0..kMomentLanes) (past the last sample they repeat
+// it). The samples, their angles and the compositing are compositeRay's; a ray that turns
+// opaque wastes at most one block's evaluations.
+template <class LaneDensity>
+VISOPT_HD inline glm::vec3 compositeRayLanes(const MomentRay& r, int n, const MomentTransfer& tf,
+                                             LaneDensity density) {
+  const float dt = (r.t1 - r.t0) / float(n - 1);
+  const float dphi = float(kMomentPi) / float(n - 1);
+  glm::vec3 radiance(0.f);
+  float transmittance = 1.f, front = 0.f;
+  float phi[kMomentLanes], value[kMomentLanes];
+  for (int k0 = 0; k0 < n && transmittance > 1e-4f; k0 += kMomentLanes) {
+    for (int i = 0; i < kMomentLanes; ++i) {
+      const int k = k0 + i < n ? k0 + i : n - 1;
+      phi[i] = -float(kMomentPi) + float(k) * dphi;
+    }
+    density(phi, value);
+    for (int i = 0; i < kMomentLanes && k0 + i < n; ++i) {
+      if (k0 + i == 0) {
+        front = value[0];
+        continue;
+      }
+      if (!(transmittance > 1e-4f)) break;
+      const glm::vec4 seg = tf.segment(front, value[i], dt);
+      radiance += transmittance * glm::vec3(seg);
+      transmittance *= 1.f - seg.w;
+      front = value[i];
+    }
+  }
+  return radiance;
+}
+
 // Renders pixels from a moment image: per pixel the stored moments (Fourier) or the Lagrange
-// multipliers computed from them (MESE, `imag` set).
+// multipliers computed from them (MESE, `imag` set). perSample evaluates one sample after the
+// other (compositeRay), the reference the lanes path is tested against.
 struct MomentRender {
   FrustumMap camera;
   GridMap volume;
@@ -212,6 +258,7 @@ struct MomentRender {
   const float* lower = nullptr;
   const float* upper = nullptr;
   glm::vec3* out = nullptr;
+  bool perSample = false;
 
   VISOPT_HD void operator()(int64_t pixel) const {
     const MomentRay r = momentRay(camera, volume, pixel);
@@ -226,8 +273,12 @@ struct MomentRender {
     d.order = int(count) - 1;
     d.lower = lower[pixel];
     d.upper = upper[pixel];
-    out[pixel] = compositeRay(r, momentSampleCount(r, step), tf,
-                              [&](float, float phi) { return d.at(phi); });
+    const int n = momentSampleCount(r, step);
+    if (perSample)
+      out[pixel] = compositeRay(r, n, tf, [&](float, float phi) { return d.at(phi); });
+    else
+      out[pixel] =
+          compositeRayLanes(r, n, tf, [&](const float* phi, float* v) { d.atLanes(phi, v); });
   }
 };
 

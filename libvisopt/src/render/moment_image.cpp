@@ -239,6 +239,7 @@ Image renderMomentImage(const MomentImage& image, const TransferFunction& tf,
   k.lower = lower.data();
   k.upper = upper.data();
   k.out = out.data();
+  k.perSample = settings.perSampleReference;
   exec::parallelFor("moments: render", int64_t(pixels), k);
   return toImage(out, image.width, image.height);
 }

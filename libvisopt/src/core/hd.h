@@ -23,8 +23,9 @@
 
 // Before a loop over SIMD lanes: keep it a loop so that the vectoriser turns it into vector
 // instructions (GCC otherwise unrolls a short constant loop completely first, and then vectorises
-// neither it nor the loop around it). A GPU thread runs the lanes one after the other.
-#if defined(__CUDA_ARCH__) || !defined(__GNUC__) || defined(__clang__)
+// neither it nor the loop around it). A GPU thread runs the lanes one after the other; nvcc
+// (which would warn on the pragma in host passes too) gets the plain loop.
+#if defined(__CUDACC__) || !defined(__GNUC__) || defined(__clang__)
 #define VISOPT_LANE_LOOP
 #else
 #define VISOPT_LANE_LOOP _Pragma("GCC unroll 1") _Pragma("GCC ivdep")

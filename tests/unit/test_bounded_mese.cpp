@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "kernels/bounded_mese.h"
+#include "kernels/bounded_mese_batch.h"
 
 namespace visopt {
 namespace {
@@ -371,6 +372,65 @@ TEST(BoundedMese, LaneEvaluationIsTheScalarOneAtEachAngle) {
     }
   }
   EXPECT_EQ(compared, 8 * 8 * kMomentLanes);
+}
+
+// boundedMeseBatch computes kMeseBatch pixels' multipliers side by side; each lane must be
+// boundedMese of that pixel: the same order (also where Levinson stops early on moments that are
+// no valid sequence, and -1 for an invalid c_0 or an empty lane) and the same multipliers to
+// double round-off.
+TEST(BoundedMese, TheBatchIsBoundedMesePerPixel) {
+  uint32_t state = 4242u;
+  auto uniform = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return double(state >> 8) / double(1u << 24);
+  };
+  int earlyStops = 0, invalid = 0, checked = 0;
+  for (int round = 0; round < 6; ++round) {
+    MeseBatch batch;
+    std::vector<std::vector<double>> seqs(kMeseBatch);
+    for (int b = 0; b < kMeseBatch; ++b) {
+      const int kind = (round * kMeseBatch + b) % 11;
+      int m = int(uniform() * 100.0);
+      if (kind == 0) m = 0;
+      if (kind == 1) m = -1;  // an empty lane
+      batch.m[b] = m;
+      if (m < 0) continue;
+      const double centre = -kPi * uniform(), width = 0.1 + uniform();
+      seqs[b] = momentsOfSamples(
+          [&](double p) {
+            const double u = (p - centre) / width;
+            return 0.05 + (std::abs(u) < 1.0 ? 0.8 * 0.5 * (1.0 + std::cos(kPi * u)) : 0.0);
+          },
+          m, 1200);
+      if (kind == 2 && m > 4) seqs[b][m / 2] += 0.6;  // no longer a valid sequence past m / 2
+      if (kind == 3) seqs[b][0] = 0.0;                // c_0 outside (0, 1)
+    }
+    for (int b = 0; b < kMeseBatch; ++b)
+      for (int l = 0; l < kMomentCapacity; ++l)
+        batch.c[l * kMeseBatch + b] = l <= batch.m[b] ? seqs[b][l] : 0.0;
+    boundedMeseBatch(batch);
+    for (int b = 0; b < kMeseBatch; ++b) {
+      if (batch.m[b] < 0) {
+        EXPECT_EQ(batch.order[b], -1);
+        continue;
+      }
+      MomentComplex lambda[kMomentCapacity];
+      const int order = boundedMese(seqs[b].data(), batch.m[b], lambda);
+      ASSERT_EQ(batch.order[b], order) << "round " << round << " lane " << b;
+      earlyStops += order >= 0 && order < batch.m[b];
+      invalid += order < 0;
+      for (int l = 0; l <= order; ++l) {
+        const double re = batch.lambdaRe[l * kMeseBatch + b],
+                     im = batch.lambdaIm[l * kMeseBatch + b];
+        EXPECT_NEAR(re, lambda[l].re, 1e-9 * (1.0 + std::abs(lambda[l].re))) << b << " " << l;
+        EXPECT_NEAR(im, lambda[l].im, 1e-9 * (1.0 + std::abs(lambda[l].im))) << b << " " << l;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(earlyStops, 0);
+  EXPECT_GT(invalid, 0);
+  EXPECT_GT(checked, 500);
 }
 
 TEST(BoundedMese, InvalidMomentsAreRefusedNotReconstructed) {

@@ -82,8 +82,9 @@ struct MomentRenderSettings {
   // extinction and the emitted colour integrated over the segment's linear density ramp, the
   // self-attenuation within a segment neglected); false samples each segment at its midpoint.
   bool preintegrate = true;
-  // Evaluate each ray's density one sample after the other (the reference); false evaluates
-  // 16 samples side by side (the same arithmetic per sample, SIMD-wide).
+  // Evaluate each ray's density one sample after the other and each pixel's multipliers one
+  // pixel after the other (the reference); false evaluates 16 samples, and on the CPU the
+  // multipliers of 8 pixels, side by side (the same arithmetic per sample and pixel, SIMD-wide).
   bool perSampleReference = false;
 };
 

@@ -308,6 +308,10 @@ struct VolumeEmissionAbsorption {
 // floats (zero past the order used); returns that order. c_0 outside (0, 1) cannot be (Eq. 5
 // puts the mean strictly inside the bounds); should it happen, the constant with that mean
 // (lambda_0 = tan(pi (c_0 - 1/2)), order 0) is what remains.
+VISOPT_HD inline float constantMultiplier(double c0) {
+  return float(tan(kMomentPi * (fmin(fmax(c0, 1e-6), 1.0 - 1e-6) - 0.5)));
+}
+
 VISOPT_HD inline int pixelMultipliers(const float* moments, int count, float* re, float* im) {
   double c[kMomentCapacity] = {};
   for (int j = 0; j < count; ++j) c[j] = double(moments[j]);
@@ -318,7 +322,7 @@ VISOPT_HD inline int pixelMultipliers(const float* moments, int count, float* re
     im[j] = j <= order ? float(lambda[j].im) : 0.f;
   }
   if (order >= 0) return order;
-  re[0] = float(tan(kMomentPi * (fmin(fmax(c[0], 1e-6), 1.0 - 1e-6) - 0.5)));
+  re[0] = constantMultiplier(c[0]);
   return 0;
 }
 

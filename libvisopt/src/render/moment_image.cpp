@@ -11,6 +11,7 @@
 #include "core/field_view.h"
 #include "core/frustum_map.h"
 #include "exec/parallel.h"
+#include "kernels/bounded_mese_batch.h"
 #include "kernels/moment_image.h"
 #include "visopt/colormap.h"
 #include "visopt/error.h"
@@ -188,18 +189,56 @@ namespace {
 // The Lagrange multipliers of every pixel's stored moments (§3.3: computed once on loading),
 // real and imaginary parts at the pixel's offsets. A pixel whose higher moments do not form a
 // valid sequence (quantization could do that; float storage rarely) keeps the valid prefix: its
-// unused multipliers are zero.
-struct LagrangeOfPixels {
+// unused multipliers are zero. One call serves kMeseBatch consecutive pixels: on the CPU side
+// by side (kernels/bounded_mese_batch.h), on a GPU thread one after the other.
+struct LagrangeOfPixelBatches {
+  int64_t pixels = 0;
   const uint64_t* offsets = nullptr;
   const float* moments = nullptr;
   float* re = nullptr;
   float* im = nullptr;
+  bool perPixel = false;  // pixelMultipliers one pixel at a time (the reference)
 
-  VISOPT_HD void operator()(int64_t pixel) const {
-    const uint64_t begin = offsets[pixel];
-    const int count = int(offsets[pixel + 1] - begin);
-    if (count > 0) pixelMultipliers(moments + begin, count, re + begin, im + begin);
+  VISOPT_HD void operator()(int64_t batch) const {
+    const int64_t first = batch * kMeseBatch;
+    const int lanes = int(pixels - first < kMeseBatch ? pixels - first : kMeseBatch);
+#if !defined(VISOPT_ON_DEVICE)
+    if (!perPixel) {
+      batched(first, lanes);
+      return;
+    }
+#endif
+    for (int b = 0; b < lanes; ++b) {
+      const uint64_t begin = offsets[first + b];
+      const int count = int(offsets[first + b + 1] - begin);
+      if (count > 0) pixelMultipliers(moments + begin, count, re + begin, im + begin);
+    }
   }
+
+#if !defined(VISOPT_ON_DEVICE)
+  void batched(int64_t first, int lanes) const {
+    MeseBatch job;
+    for (double& c : job.c) c = 0.0;
+    for (int b = 0; b < kMeseBatch; ++b) {
+      job.m[b] = -1;
+      if (b >= lanes) continue;
+      const uint64_t begin = offsets[first + b];
+      const int count = int(offsets[first + b + 1] - begin);
+      job.m[b] = count - 1;
+      for (int j = 0; j < count; ++j) job.c[j * kMeseBatch + b] = double(moments[begin + j]);
+    }
+    boundedMeseBatch(job);
+    for (int b = 0; b < lanes; ++b) {
+      const uint64_t begin = offsets[first + b];
+      const int count = job.m[b] + 1, order = job.order[b];
+      for (int j = 0; j < count; ++j) {
+        re[begin + j] = j <= order ? float(job.lambdaRe[j * kMeseBatch + b]) : 0.f;
+        im[begin + j] = j <= order ? float(job.lambdaIm[j * kMeseBatch + b]) : 0.f;
+      }
+      if (count > 0 && order < 0) re[begin] = constantMultiplier(job.c[b]);
+    }
+  }
+#endif
 };
 
 }  // namespace
@@ -220,8 +259,10 @@ Image renderMomentImage(const MomentImage& image, const TransferFunction& tf,
     DeviceBuffer<float> moments(std::max<size_t>(stored, 1));
     std::copy(image.moments.begin(), image.moments.end(), moments.data());
     imag = DeviceBuffer<float>(std::max<size_t>(stored, 1));
-    exec::parallelFor("moments: lagrange multipliers", int64_t(pixels),
-                      LagrangeOfPixels{off.data(), moments.data(), values.data(), imag.data()});
+    LagrangeOfPixelBatches k{int64_t(pixels), off.data(),  moments.data(),
+                             values.data(),   imag.data(), settings.perSampleReference};
+    exec::parallelFor("moments: lagrange multipliers",
+                      (int64_t(pixels) + kMeseBatch - 1) / kMeseBatch, k);
   } else {
     std::copy(image.moments.begin(), image.moments.end(), values.data());
   }

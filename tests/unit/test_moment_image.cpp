@@ -186,7 +186,14 @@ TEST(MomentImage, RendersLikeTheVolumeWithANewTransferFunction) {
 // The renderer's lanes path (kMomentLanes samples side by side) against its per-sample reference:
 // the same images to float round-off, MESE and Fourier, pre-integrated and midpoint, and with a
 // transfer function dense enough that rays turn opaque part-way through a block of samples.
+// The densities themselves agree to float round-off (the lanes tests above); pre-integration
+// then amplifies their round-off: its lookup (F(x_b) - F(x_f)) / (x_b - x_f) divides by density
+// steps down to 1e-3, so its slope reaches ~1e3 times the transfer function's, and a density
+// difference of one float ulp (~1e-7) moves a sample's opacity by up to ~1e-4. The CUDA build's
+// different inlining showed 1.1e-4 (Fourier, Shepp-Logan); the bound allows that conditioning.
+// A lane mixed up with another moves pixels by the image's own contrast (>= 0.02 here).
 TEST(MomentImage, TheLaneRenderEqualsThePerSampleReference) {
+  constexpr float kPreintegratedBound = 1e-3f;
   for (const char* name : {"marschner-lobb", "shepp-logan"}) {
     const BuiltinScene s = scene(name, 48);
     const Camera cam = viewOf(s);
@@ -214,8 +221,9 @@ TEST(MomentImage, TheLaneRenderEqualsThePerSampleReference) {
             worst = std::max({worst, d.x, d.y, d.z});
             brightest = std::max(brightest, reference.pixels[p].x);
           }
-          EXPECT_LE(worst, 1e-5f) << name << " " << toString(rec) << " pre " << pre << " "
-                                  << (t == 1 ? "dense" : "scene");
+          EXPECT_LE(worst, pre ? kPreintegratedBound : 1e-5f)
+              << name << " " << toString(rec) << " pre " << pre << " "
+              << (t == 1 ? "dense" : "scene");
           EXPECT_GT(brightest, 0.02f) << name << ": a black image compares trivially";
         }
   }

@@ -316,7 +316,7 @@ VISOPT_HD inline int momentCountFor(const double* c, int m, double threshold) {
   int lo = 0, hi = m;
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    const double e = mid >= m ? 0.0 : (valid ? truncationErrorFrom(c, gamma, mid, m) : 1e300);
+    const double e = valid ? truncationErrorFrom(c, gamma, mid, m) : 1e300;  // mid < m
     if (e <= threshold)
       hi = mid;
     else

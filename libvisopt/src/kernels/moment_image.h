@@ -191,6 +191,19 @@ struct MomentDensity {
   }
 };
 
+// The front-to-back sum of a ray's segments; the ray counts as opaque once its transmittance
+// falls to 1e-4.
+struct FrontToBack {
+  glm::vec3 radiance{0.f};
+  float transmittance = 1.f;
+  VISOPT_HD bool open() const { return transmittance > 1e-4f; }
+  VISOPT_HD void add(const MomentTransfer& tf, float front, float back, float dt) {
+    const glm::vec4 seg = tf.segment(front, back, dt);
+    radiance += transmittance * glm::vec3(seg);
+    transmittance *= 1.f - seg.w;
+  }
+};
+
 // Front-to-back emission-absorption along one ray, `n` samples from t0 to t1, density(k, t,
 // phi) giving the normalised density at sample k.
 template <class Density>
@@ -198,17 +211,14 @@ VISOPT_HD inline glm::vec3 compositeRay(const MomentRay& r, int n, const MomentT
                                         Density density) {
   const float dt = (r.t1 - r.t0) / float(n - 1);
   const float dphi = float(kMomentPi) / float(n - 1);
-  glm::vec3 radiance(0.f);
-  float transmittance = 1.f;
+  FrontToBack sum;
   float front = density(r.t0, -float(kMomentPi));
-  for (int k = 1; k < n && transmittance > 1e-4f; ++k) {
+  for (int k = 1; k < n && sum.open(); ++k) {
     const float back = density(r.t0 + float(k) * dt, -float(kMomentPi) + float(k) * dphi);
-    const glm::vec4 seg = tf.segment(front, back, dt);
-    radiance += transmittance * glm::vec3(seg);
-    transmittance *= 1.f - seg.w;
+    sum.add(tf, front, back, dt);
     front = back;
   }
-  return radiance;
+  return sum.radiance;
 }
 
 // compositeRay with the density taken kMomentLanes samples at a time, density(phi, out) giving
@@ -220,10 +230,10 @@ VISOPT_HD inline glm::vec3 compositeRayLanes(const MomentRay& r, int n, const Mo
                                              LaneDensity density) {
   const float dt = (r.t1 - r.t0) / float(n - 1);
   const float dphi = float(kMomentPi) / float(n - 1);
-  glm::vec3 radiance(0.f);
-  float transmittance = 1.f, front = 0.f;
+  FrontToBack sum;
+  float front = 0.f;
   float phi[kMomentLanes], value[kMomentLanes];
-  for (int k0 = 0; k0 < n && transmittance > 1e-4f; k0 += kMomentLanes) {
+  for (int k0 = 0; k0 < n && sum.open(); k0 += kMomentLanes) {
     for (int i = 0; i < kMomentLanes; ++i) {
       const int k = k0 + i < n ? k0 + i : n - 1;
       phi[i] = -float(kMomentPi) + float(k) * dphi;
@@ -234,14 +244,12 @@ VISOPT_HD inline glm::vec3 compositeRayLanes(const MomentRay& r, int n, const Mo
         front = value[0];
         continue;
       }
-      if (!(transmittance > 1e-4f)) break;
-      const glm::vec4 seg = tf.segment(front, value[i], dt);
-      radiance += transmittance * glm::vec3(seg);
-      transmittance *= 1.f - seg.w;
+      if (!sum.open()) break;
+      sum.add(tf, front, value[i], dt);
       front = value[i];
     }
   }
-  return radiance;
+  return sum.radiance;
 }
 
 // Renders pixels from a moment image: per pixel the stored moments (Fourier) or the Lagrange

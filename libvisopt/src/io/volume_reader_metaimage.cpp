@@ -35,7 +35,7 @@ bool isTrue(const std::string& v) {
 
 }  // namespace
 
-LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& progress) {
+VolumeLayout metaImageLayout(const std::string& path, bool wholeInMemory) {
   const uint64_t fileSize = checkedFileSize(path);
   const std::string text = readFilePrefix(path, 1 << 20);
 
@@ -112,11 +112,12 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
     if (fields.count(key)) bigEndian = isTrue(fields[key]);
   const bool compressed = fields.count("CompressedData") && isTrue(fields["CompressedData"]);
 
-  LoadedVolume out;
-  out.format = "metaimage";
-  out.grid = checkHeader(path, h);
-  reportProgress(progress, path, 0.1f, "header");
-  const size_t count = out.grid.voxelCount();
+  VolumeLayout layout;
+  layout.format = "metaimage";
+  layout.headerPath = path;
+  layout.header = h;
+  layout.grid = checkHeader(path, h, wholeInMemory);
+  const size_t count = layout.grid.voxelCount();
 
   std::string dataFile = fields["ElementDataFile"];
   if (dataFile == "LOCAL") {
@@ -140,8 +141,25 @@ LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& prog
       }
     }
   }
-  out.scalars = compressed ? readCompressedPayload(dataFile, dataOffset, h.type, count, bigEndian)
-                           : readPayload(dataFile, dataOffset, h.type, count, bigEndian);
+  layout.dataPath = dataFile;
+  layout.dataOffset = dataOffset;
+  layout.bigEndian = bigEndian;
+  layout.compressed = compressed;
+  return layout;
+}
+
+LoadedVolume readMetaImage(const std::string& path, const ProgressCallback& progress) {
+  const VolumeLayout layout = metaImageLayout(path);
+  LoadedVolume out;
+  out.format = layout.format;
+  out.grid = layout.grid;
+  reportProgress(progress, path, 0.1f, "header");
+  const ScalarType type = layout.header.type;
+  const size_t count = out.grid.voxelCount();
+  out.scalars =
+      layout.compressed
+          ? readCompressedPayload(layout.dataPath, layout.dataOffset, type, count, layout.bigEndian)
+          : readPayload(layout.dataPath, layout.dataOffset, type, count, layout.bigEndian);
   return out;
 }
 

@@ -9,13 +9,18 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 
+#include <vtkDataObject.h>
+#include <vtkDataSetAttributes.h>
 #include <vtkImageData.h>
+#include <vtkInformation.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNIFTIImageReader.h>
 #include <vtkNew.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
 
 #include "io/file_util.h"
 #include "io/vtk_image_reading.h"
@@ -29,7 +34,7 @@ namespace {
 // The header fields vtkNIFTIImageReader trusts, checked before it sees the file: a datatype it
 // does not know with bitpix 0, or a dim it multiplies without bounds, crashed it (mutants of a
 // valid file, issue 13). NIfTI-1 (348-byte header) and NIfTI-2 (540), either byte order; .nii.gz
-// is inflated as far as the header. Returns nothing; throws BadInput naming the field.
+// is inflated as far as the header. Throws BadInput naming the field.
 template <class T>
 T field(const unsigned char* h, size_t offset, bool swap) {
   T v;
@@ -46,7 +51,41 @@ std::string wholeNumber(double v) {
   return text.str();
 }
 
-void checkNiftiHeader(const std::string& path, uint64_t fileSize) {
+// What checkNiftiHeader found: where the data lies and how it is stored.
+struct NiftiFileHeader {
+  bool gz = false;
+  bool swap = false;  // the file's byte order is not the host's
+  ScalarType type = ScalarType::Int16;
+  double offset = 0.0;     // vox_offset
+  double bytes = 0.0;      // of the data, all dims (time frames and vector planes included)
+  uint64_t available = 0;  // the file's size (inflated, for .gz)
+};
+
+std::optional<ScalarType> niftiScalarType(int16_t datatype) {
+  switch (datatype) {
+    case 2:
+      return ScalarType::UInt8;
+    case 4:
+      return ScalarType::Int16;
+    case 8:
+      return ScalarType::Int32;
+    case 16:
+      return ScalarType::Float32;
+    case 64:
+      return ScalarType::Float64;
+    case 256:
+      return ScalarType::Int8;
+    case 512:
+      return ScalarType::UInt16;
+    case 768:
+      return ScalarType::UInt32;
+    default:
+      return std::nullopt;
+  }
+}
+
+// The checks on the header alone (everything but checkNiftiData's).
+NiftiFileHeader parseNiftiHeader(const std::string& path, uint64_t fileSize) {
   unsigned char h[540] = {};
   const bool gz = endsWithNoCase(path, ".gz");
   size_t got = 0;
@@ -107,28 +146,32 @@ void checkNiftiHeader(const std::string& path, uint64_t fileSize) {
                               : field<float>(h, 76 + 4 * size_t(d), swap);
     if (!std::isfinite(pixdim)) throwBadInput(path, "invalid NIfTI pixdim (not finite)");
   }
-  // The data must be in the file before VTK allocates for it.
-  if (offset + bytes > double(available))
-    throwBadInput(path, "truncated: the header describes " + wholeNumber(bytes) +
-                            " bytes of data after offset " + wholeNumber(offset) +
-                            ", the file has " + wholeNumber(double(available)) + " bytes" +
-                            (gz ? " once inflated" : ""));
+  NiftiFileHeader out;
+  out.gz = gz;
+  out.swap = swap;
+  out.type = niftiScalarType(datatype).value_or(ScalarType::Int16);  // known: supported above
+  out.offset = offset;
+  out.bytes = bytes;
+  out.available = available;
+  return out;
 }
 
-}  // namespace
+// The data must be in the file before VTK allocates for it.
+void checkNiftiData(const std::string& path, const NiftiFileHeader& f) {
+  if (f.offset + f.bytes > double(f.available))
+    throwBadInput(path, "truncated: the header describes " + wholeNumber(f.bytes) +
+                            " bytes of data after offset " + wholeNumber(f.offset) +
+                            ", the file has " + wholeNumber(double(f.available)) + " bytes" +
+                            (f.gz ? " once inflated" : ""));
+}
 
-LoadedVolume readNifti(const std::string& path, const ProgressCallback& progress) {
-  checkNiftiHeader(path, checkedFileSize(path));
-  vtkNew<vtkNIFTIImageReader> reader;
-  {
-    VtkErrorCapture capture(reader);
-    if (!reader->CanReadFile(path.c_str()))
-      throwBadInput(path, "not a NIfTI file (bad header or truncated)");
-  }
-  reader->SetFileName(path.c_str());
-  VtkImageRead read = runVtkImageReader(path, reader, progress);
-  VolumeHeader h = headerFromVtkImage(read);
+void checkNiftiHeader(const std::string& path, uint64_t fileSize) {
+  checkNiftiData(path, parseNiftiHeader(path, fileSize));
+}
 
+// World geometry from the sform (else qform) matrix of a reader that has read the header: `h`
+// holds VTK's data geometry (spacing, zero origin, identity direction); see the top of the file.
+void applyNiftiMatrix(const std::string& path, vtkNIFTIImageReader* reader, VolumeHeader& h) {
   vtkMatrix4x4* m = reader->GetSFormMatrix();
   if (!m) m = reader->GetQFormMatrix();
   if (m) {
@@ -148,16 +191,86 @@ LoadedVolume readNifti(const std::string& path, const ProgressCallback& progress
       for (int r = 0; r < 3; ++r) h.direction[size_t(c)][size_t(r)] = col[r] / len;
     }
   }
+}
+
+// scl_slope / scl_inter, when usable (a zero or non-finite slope means "not rescaled").
+void niftiRescale(vtkNIFTIImageReader* reader, double& slope, double& intercept) {
+  const double s = reader->GetRescaleSlope(), i = reader->GetRescaleIntercept();
+  if (std::isfinite(s) && s != 0.0 && std::isfinite(i)) {
+    slope = s;
+    intercept = i;
+  }
+}
+
+}  // namespace
+
+LoadedVolume readNifti(const std::string& path, const ProgressCallback& progress) {
+  checkNiftiHeader(path, checkedFileSize(path));
+  vtkNew<vtkNIFTIImageReader> reader;
+  {
+    VtkErrorCapture capture(reader);
+    if (!reader->CanReadFile(path.c_str()))
+      throwBadInput(path, "not a NIfTI file (bad header or truncated)");
+  }
+  reader->SetFileName(path.c_str());
+  VtkImageRead read = runVtkImageReader(path, reader, progress);
+  VolumeHeader h = headerFromVtkImage(read);
+  applyNiftiMatrix(path, reader, h);
   LoadedVolume out;
   out.format = "nifti";
   out.grid = checkHeader(path, h);
   out.scalars = read.scalars;
-  const double slope = reader->GetRescaleSlope(), intercept = reader->GetRescaleIntercept();
-  if (std::isfinite(slope) && slope != 0.0 && std::isfinite(intercept)) {
-    out.scalars.slope = slope;
-    out.scalars.intercept = intercept;
-  }
+  niftiRescale(reader, out.scalars.slope, out.scalars.intercept);
   return out;
+}
+
+VolumeLayout niftiLayout(const std::string& path, bool wholeInMemory) {
+  const NiftiFileHeader file = parseNiftiHeader(path, checkedFileSize(path));
+  vtkNew<vtkNIFTIImageReader> reader;
+  VtkErrorCapture capture(reader);
+  if (!reader->CanReadFile(path.c_str()))
+    throwBadInput(path, "not a NIfTI file (bad header or truncated)");
+  capture.clear();
+  reader->SetFileName(path.c_str());
+  reader->UpdateInformation();  // the header only: RequestInformation reads no data
+  auto detail = capture.error();
+  if (detail || reader->GetErrorCode() != 0)
+    throwBadInput(path, "cannot read the header" + (detail ? ": " + *detail : std::string()));
+  vtkInformation* info = reader->GetOutputInformation(0);
+  if (!info || !info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+    throwBadInput(path, "cannot read the header (no image extent)");
+  // What headerFromVtkImage gives for the image VTK would read: extent, spacing, origin (zero),
+  // identity direction.
+  int extent[6];
+  info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent);
+  double spacing[3] = {1, 1, 1}, origin[3] = {0, 0, 0};
+  if (info->Has(vtkDataObject::SPACING())) info->Get(vtkDataObject::SPACING(), spacing);
+  if (info->Has(vtkDataObject::ORIGIN())) info->Get(vtkDataObject::ORIGIN(), origin);
+  VolumeHeader h;
+  h.type = file.type;
+  if (vtkInformation* scalarInfo = vtkDataObject::GetActiveFieldInformation(
+          info, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS))
+    if (scalarInfo->Has(vtkDataObject::FIELD_NUMBER_OF_COMPONENTS()))
+      h.components = scalarInfo->Get(vtkDataObject::FIELD_NUMBER_OF_COMPONENTS());
+  for (int a = 0; a < 3; ++a) {
+    h.dims[size_t(a)] = int64_t(extent[2 * a + 1]) - extent[2 * a] + 1;
+    h.spacing[size_t(a)] = spacing[a];
+    h.origin[size_t(a)] = origin[a] + double(extent[2 * a]) * spacing[a];
+  }
+  applyNiftiMatrix(path, reader, h);
+
+  VolumeLayout layout;
+  layout.format = "nifti";
+  layout.headerPath = path;
+  layout.header = h;
+  layout.grid = checkHeader(path, h, wholeInMemory);
+  layout.dataPath = path;
+  layout.dataOffset = uint64_t(file.offset);  // as VTK's SetHeaderSize(unsigned long(vox_offset))
+  layout.bigEndian = file.swap != hostIsBigEndian();
+  layout.compressed = file.gz;
+  layout.reversedSlices = reader->GetQFac() < 0;  // VTK reads the slices in reverse order
+  niftiRescale(reader, layout.slope, layout.intercept);
+  return layout;
 }
 
 }  // namespace visopt::io

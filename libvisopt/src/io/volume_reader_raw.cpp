@@ -61,7 +61,7 @@ std::array<T, N> numberArray(const std::string& sidecar, const json& doc, const 
 
 }  // namespace
 
-LoadedVolume readRawWithSidecar(const std::string& path, const ProgressCallback& progress) {
+VolumeLayout rawLayout(const std::string& path, bool wholeInMemory) {
   checkedFileSize(path);  // missing / empty data file first: the clearest message
   const std::string sidecar = findSidecar(path);
   json doc;
@@ -114,12 +114,25 @@ LoadedVolume readRawWithSidecar(const std::string& path, const ProgressCallback&
     headerBytes = doc["headerBytes"].get<int64_t>();
   }
 
+  VolumeLayout layout;
+  layout.format = "raw";
+  layout.headerPath = sidecar;
+  layout.header = header;
+  layout.grid = checkHeader(sidecar, header, wholeInMemory);
+  layout.dataPath = path;
+  layout.dataOffset = uint64_t(headerBytes);
+  layout.bigEndian = bigEndian;
+  return layout;
+}
+
+LoadedVolume readRawWithSidecar(const std::string& path, const ProgressCallback& progress) {
+  VolumeLayout layout = rawLayout(path);
   LoadedVolume out;
-  out.format = "raw";
-  out.grid = checkHeader(sidecar, header);
+  out.format = layout.format;
+  out.grid = layout.grid;
   reportProgress(progress, path, 0.1f, "header");
-  out.scalars =
-      readPayload(path, uint64_t(headerBytes), header.type, out.grid.voxelCount(), bigEndian);
+  out.scalars = readPayload(path, layout.dataOffset, layout.header.type, out.grid.voxelCount(),
+                            layout.bigEndian);
   return out;
 }
 

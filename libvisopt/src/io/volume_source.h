@@ -49,13 +49,40 @@ struct LoadedVolume {
 };
 
 // Checks dims (> 0, fits in int, product and fp32 bytes do not overflow, fp32 bytes fit in
-// availableMemoryBytes()), components (1), spacing (> 0, finite), origin (finite) and direction
-// (finite, orthonormal). Throws BadInput naming `path`. Returns the grid it describes.
-GridSpec checkHeader(const std::string& path, const VolumeHeader& header);
+// availableMemoryBytes() unless !wholeInMemory), components (1), spacing (> 0, finite), origin
+// (finite) and direction (finite, orthonormal). Throws BadInput naming `path`. Returns the grid
+// it describes. wholeInMemory = false: for readers that never hold the whole volume (slabs).
+GridSpec checkHeader(const std::string& path, const VolumeHeader& header,
+                     bool wholeInMemory = true);
 
 // Calls progress (if any) and throws Error(Cancelled, "PATH: cancelled") when it returns false.
 void reportProgress(const ProgressCallback& progress, const std::string& path, float fraction,
                     const std::string& stage);
+
+// Where a file's scalars lie, from its header alone (no data read), for reading them in parts
+// (VolumeSlabReader). Voxel (i, j, k) of the grid is stored at byte
+//   dataOffset + ((k' * ny + j) * nx + i) * scalarTypeSize(header.type)  of dataPath,
+// with k' = k, or dims.z - 1 - k when reversedSlices; value = slope * stored + intercept.
+struct VolumeLayout {
+  std::string format;      // as LoadedVolume::format
+  std::string headerPath;  // the file the header came from (a raw volume's JSON sidecar)
+  VolumeHeader header;
+  GridSpec grid;  // checkHeader(headerPath, header, wholeInMemory)
+  std::string dataPath;
+  uint64_t dataOffset = 0;
+  bool bigEndian = false;
+  bool compressed = false;      // a zlib/gzip stream from dataOffset: no offset reads
+  bool reversedSlices = false;  // NIfTI with qfac -1 or a reflecting sform (VTK's slice order)
+  double slope = 1.0, intercept = 0.0;
+  std::vector<std::string> warnings;
+};
+
+// The header parsing of readRawWithSidecar, readMetaImage and readNifti (each in its reader's
+// file), same checks and messages; nothing past the header is read (readNifti's check that the
+// data fits in the file is left to whoever reads it).
+VolumeLayout rawLayout(const std::string& path, bool wholeInMemory = true);
+VolumeLayout metaImageLayout(const std::string& path, bool wholeInMemory = true);
+VolumeLayout niftiLayout(const std::string& path, bool wholeInMemory = true);
 
 // Format readers (each in its own file).
 LoadedVolume readRawWithSidecar(const std::string& path, const ProgressCallback& progress);

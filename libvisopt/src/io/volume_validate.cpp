@@ -38,7 +38,7 @@ std::string humanBytes(double bytes) {
 
 }  // namespace
 
-GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
+GridSpec checkHeader(const std::string& path, const VolumeHeader& h, bool wholeInMemory) {
   for (int a = 0; a < 3; ++a)
     if (h.dims[a] <= 0)
       throwBadInput(path, "invalid dimensions " + dimsText(h.dims) + " (each must be >= 1)");
@@ -64,7 +64,7 @@ GridSpec checkHeader(const std::string& path, const VolumeHeader& h) {
     throwBadInput(path, "multi-component data (" + std::to_string(h.components) +
                             " components per voxel) is not supported; need one scalar per voxel");
   const size_t available = availableMemoryBytes();
-  if (fp32Bytes > available)
+  if (wholeInMemory && fp32Bytes > available)
     throwBadInput(path, "dimensions " + dimsText(h.dims) + " need " +
                             humanBytes(double(fp32Bytes)) +
                             " as fp32, more than the available memory (" +

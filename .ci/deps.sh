@@ -8,6 +8,7 @@ PACKAGES=(
   libvtk9-dev libvtkgdcm-dev libopenvdb-dev libboost-iostreams-dev libopenmesh-dev
   liblz4-dev libzstd-dev libgtest-dev libbenchmark-dev
   qt6-base-dev xvfb xauth clang-format
+  libopenmpi-dev openmpi-bin
   clang libclang-rt-14-dev
 )
 missing=()

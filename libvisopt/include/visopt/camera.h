@@ -30,6 +30,12 @@ struct Camera {
 inline constexpr float kMinOrbitRadii = 1e-3f;
 inline constexpr float kMaxOrbitRadii = 1e4f;
 
+// The orbit a volume file opens with (a scene has its own): from the front, slightly above.
+struct OrbitView {
+  float azimuthDeg, elevationDeg, distanceInRadii;
+};
+inline constexpr OrbitView kDefaultVolumeView{0.f, 10.f, 2.6f};
+
 // Throws Error(Usage) naming `what` unless the camera can render `bounds`: finite eye, target
 // and up, a field of view of 1..170 degrees, the eye kMinOrbitRadii..kMaxOrbitRadii bounding
 // radii from the target and within kMaxOrbitRadii of the bounds' centre, up not along the view.

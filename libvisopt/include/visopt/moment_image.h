@@ -10,10 +10,12 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "visopt/camera.h"
+#include "visopt/field.h"
 #include "visopt/grid.h"
 #include "visopt/image.h"
 #include "visopt/transfer_function.h"
@@ -71,6 +73,51 @@ struct MomentGenerationStats {
 MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
                                 const MomentImageSettings& settings,
                                 MomentGenerationStats* stats = nullptr);
+
+// Distributed generation (§3.2's moments are integrals along the ray: those of disjoint pieces
+// add, and Eq. 5's rescaling is linear in them). The grid is cut into slabs along z; a slab owns
+// the ray samples whose z lies in its slices and adds the raw moments of the piece from its first
+// sample to the one after its last, and the min and max of its samples. The partials of all slabs
+// summed (min and max for the bounds), in any order and on any process, and finished give
+// generateMomentImage's image up to the order of the sums (double precision). The §4.1
+// uncertainty, a second march over each whole ray, is not computed this way.
+struct MomentPartials {
+  int width = 0, height = 0, order = 0;
+  std::vector<double> moments;  // per pixel, order + 1 raw moments of the pieces added
+  std::vector<float> lower,
+      upper;  // per pixel, min and max of the samples added (none: lower > upper)
+};
+MomentPartials emptyMomentPartials(const MomentImageSettings& settings);
+// Slices beyond its own on each side that a slab must hold (the piece's last sample and the
+// trilinear stencil): ceil(stepVoxels) + 1.
+int momentSlabHalo(const MomentImageSettings& settings);
+// Adds the slab owning slices [ownedBegin, ownedEnd) of `grid` (the whole volume's geometry),
+// read from `slab`: the normalised density of slices [slabFirst, slabFirst + its dims.z) with
+// the grid's x and y dims, holding the owned slices and momentSlabHalo more each side (as far as
+// the grid has them). Throws Error(Usage) otherwise. marchMs, when given, is added the time.
+void addMomentSlab(MomentPartials& partials, const Field3D& slab, int slabFirst, int ownedBegin,
+                   int ownedEnd, const GridSpec& grid, const Camera& camera,
+                   const MomentImageSettings& settings, double* marchMs = nullptr);
+// into += other (sums; min and max of the bounds): what a reduction across processes does.
+void mergeMomentPartials(MomentPartials& into, const MomentPartials& other);
+// Eq. 5 and §3.5's counts for a run of pixels from their merged partials (order + 1 moments and
+// the bounds of each), so that processes can finish a share of the pixels each; momentImageOf
+// puts the runs of all pixels, in order, together. countMs, when given, is added the count's time.
+struct MomentPixels {
+  std::vector<uint8_t> counts;
+  std::vector<float> lower, upper, moments;  // as in MomentImage
+};
+MomentPixels finishMomentPixels(std::span<const double> moments, std::span<const float> lower,
+                                std::span<const float> upper, const MomentImageSettings& settings,
+                                double* countMs = nullptr);
+MomentImage momentImageOf(MomentPixels pixels, const GridSpec& grid, const Camera& camera,
+                          const MomentImageSettings& settings, double valueMin, double valueMax);
+// The image of every slab's partials merged: Eq. 5 and §3.5's counts, as generateMomentImage.
+// valueMin/valueMax: the data units of the normalised density 0 and 1 (the whole volume's).
+MomentImage finishMomentImage(const MomentPartials& total, const GridSpec& grid,
+                              const Camera& camera, const MomentImageSettings& settings,
+                              double valueMin, double valueMax,
+                              MomentGenerationStats* stats = nullptr);
 
 enum class MomentReconstruction { BoundedMese, Fourier };
 const char* toString(MomentReconstruction r);

@@ -365,7 +365,8 @@ void Engine::loadVolume(const std::string& path, const ProgressCallback& progres
   impl_->volume.emplace(readVolume(path, impl_->precision, &impl_->ledger, progress));
   impl_->hasTf = false;
   impl_->invalidateAll();
-  impl_->frameView(0.f, 10.f, 2.6f);
+  impl_->frameView(kDefaultVolumeView.azimuthDeg, kDefaultVolumeView.elevationDeg,
+                   kDefaultVolumeView.distanceInRadii);
 }
 
 void Engine::loadBuiltinScene(const std::string& name, int resolution, bool contextSurfaces) {
@@ -393,7 +394,8 @@ void Engine::setVolume(Volume volume) {
   impl_->volume.emplace(std::move(volume));
   impl_->hasTf = false;
   impl_->invalidateAll();
-  impl_->frameView(0.f, 10.f, 2.6f);
+  impl_->frameView(kDefaultVolumeView.azimuthDeg, kDefaultVolumeView.elevationDeg,
+                   kDefaultVolumeView.distanceInRadii);
 }
 
 bool Engine::hasVolume() const {

@@ -46,6 +46,68 @@ VISOPT_HD inline int momentSampleCount(const MomentRay& r, float step) {
   return n < 1.f ? 2 : (n > 1e6f ? 1000001 : int(n) + 1);
 }
 
+// The density a ray samples: trilinear in a field of the whole grid, or in a slab of it holding
+// slices [first, first + slab's dims.z) (distributed generation). The slab's sample is the whole
+// field's (FieldView::sample: clamped to the whole grid, the same weights) wherever the slab
+// holds the eight voxels it reads.
+struct WholeDensity {
+  FieldView field;
+  VISOPT_HD VISOPT_INLINE float operator()(glm::vec3 p) const { return field.sample(p); }
+};
+struct SlabDensity {
+  FieldView slab;
+  glm::ivec3 dims{0};  // of the whole grid
+  int first = 0;
+  VISOPT_HD VISOPT_INLINE float operator()(glm::vec3 p) const {
+    p = glm::clamp(p, glm::vec3(0.f), glm::vec3(dims - 1));
+    const glm::ivec3 i0 = glm::ivec3(p);
+    const glm::ivec3 i1 = glm::min(i0 + 1, dims - 1);
+    const glm::vec3 f = p - glm::vec3(i0);
+    const int z0 = i0.z - first, z1 = i1.z - first;
+    const float c000 = slab.at(i0.x, i0.y, z0), c100 = slab.at(i1.x, i0.y, z0);
+    const float c010 = slab.at(i0.x, i1.y, z0), c110 = slab.at(i1.x, i1.y, z0);
+    const float c001 = slab.at(i0.x, i0.y, z1), c101 = slab.at(i1.x, i0.y, z1);
+    const float c011 = slab.at(i0.x, i1.y, z1), c111 = slab.at(i1.x, i1.y, z1);
+    const float c00 = c000 + f.x * (c100 - c000), c10 = c010 + f.x * (c110 - c010);
+    const float c01 = c001 + f.x * (c101 - c001), c11 = c011 + f.x * (c111 - c011);
+    const float c0 = c00 + f.y * (c10 - c00), c1 = c01 + f.y * (c11 - c01);
+    return c0 + f.z * (c1 - c0);
+  }
+};
+
+// Sample k of a ray with n samples: its position in index space and its phase (§3: [t0, t1]
+// maps linearly to [-pi, 0]).
+VISOPT_HD VISOPT_INLINE glm::vec3 momentSamplePoint(const MomentRay& r, int k, float dt) {
+  return r.o + (r.t0 + float(k) * dt) * r.d;
+}
+
+// c += the raw bounded trigonometric moments (before Eq. 5) of the ray's piecewise linear density
+// over samples first..last (first < last), in pieces of kPiece samples that share their end
+// samples (moments of pieces add); lo, hi: the min and max of samples first..ownedLast.
+template <class Density>
+VISOPT_HD inline void addRayMoments(const MomentRay& r, int n, int first, int last, int ownedLast,
+                                    int order, const Density& density, double* c, float& lo,
+                                    float& hi) {
+  constexpr int kPiece = 64;
+  float phi[kPiece + 1], s[kPiece + 1];
+  const float dt = (r.t1 - r.t0) / float(n - 1);
+  const float dphi = float(kMomentPi) / float(n - 1);
+  for (int start = first; start < last; start += kPiece) {
+    const int end = start + kPiece < last ? start + kPiece : last;
+    for (int k = start; k <= end; ++k) {
+      const float v = density(momentSamplePoint(r, k, dt));
+      const float sv = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
+      phi[k - start] = k == n - 1 ? 0.f : -float(kMomentPi) + float(k) * dphi;
+      s[k - start] = sv;
+      if (k <= ownedLast) {
+        lo = sv < lo ? sv : lo;
+        hi = sv > hi ? sv : hi;
+      }
+    }
+    addSegmentMoments(phi, s, end - start + 1, order, c);
+  }
+}
+
 struct MomentGeneration {
   FrustumMap camera;
   GridMap volume;
@@ -72,32 +134,73 @@ struct MomentGeneration {
     const int n = momentSampleCount(r, step);
     double c[kMomentCapacity];
     for (int j = 0; j < stride; ++j) c[j] = 0.0;
-    // In pieces of kPiece samples sharing their end samples (moments of pieces add).
-    constexpr int kPiece = 64;
-    float phi[kPiece + 1], s[kPiece + 1];
     float lo = 1e30f, hi = -1e30f;
-    const float dt = (r.t1 - r.t0) / float(n - 1);
-    const float dphi = float(kMomentPi) / float(n - 1);
-    for (int start = 0; start < n - 1; start += kPiece) {
-      const int end = start + kPiece < n - 1 ? start + kPiece : n - 1;
-      for (int k = start; k <= end; ++k) {
-        const float v = density.sample(r.o + (r.t0 + float(k) * dt) * r.d);
-        const float sv = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
-        phi[k - start] = k == n - 1 ? 0.f : -float(kMomentPi) + float(k) * dphi;
-        s[k - start] = sv;
-        lo = sv < lo ? sv : lo;
-        hi = sv > hi ? sv : hi;
-      }
-      addSegmentMoments(phi, s, end - start + 1, order, c);
-    }
-    // Eq. 5: the moments of (s - lower) / (upper - lower).
+    addRayMoments(r, n, 0, n - 1, n - 1, order, WholeDensity{density}, c, lo, hi);
+    rescaleMoments(c, order, lo, hi, margin, out, lower[pixel], upper[pixel]);
+    samples[pixel] = n;
+  }
+
+  // Eq. 5: the moments of (s - lower) / (upper - lower), lower = lo - margin, upper = hi + margin.
+  VISOPT_HD static void rescaleMoments(const double* c, int order, float lo, float hi, float margin,
+                                       float* out, float& lower, float& upper) {
     const double a = double(lo) - double(margin), b = double(hi) + double(margin);
     const double scale = 1.0 / (b - a);
     out[0] = float((c[0] - a) * scale);
-    for (int j = 1; j < stride; ++j) out[j] = float(c[j] * scale);
-    lower[pixel] = float(a);
-    upper[pixel] = float(b);
-    samples[pixel] = n;
+    for (int j = 1; j <= order; ++j) out[j] = float(c[j] * scale);
+    lower = float(a);
+    upper = float(b);
+  }
+};
+
+// Distributed generation: the part of every pixel's ray that one slab of the grid owns. Sample k
+// belongs to the slab whose owned slices [ownedBegin, ownedEnd) hold its z (the first slab's
+// range open below, the last's above, so that each sample has exactly one owner; along a
+// straight ray a slab's samples are consecutive). The slab adds the raw moments of the piece
+// from its first sample to the sample after its last (the next slab's first: pieces sharing end
+// samples add up to the whole ray's moments) and the min and max of its own samples; summed over
+// the slabs (min and max for the bounds) and rescaled by Eq. 5, that is generateMomentImage's
+// result up to the order of the sums. The slab must hold the slices that piece reads: the owned
+// ones and momentSlabHalo more on each side.
+struct MomentSlabGeneration {
+  FrustumMap camera;
+  GridMap volume;  // the whole grid
+  SlabDensity density;
+  float ownedBegin = -1e30f, ownedEnd = 1e30f;  // z in index units
+  int order = 0;
+  float step = 1.f;           // world units
+  double* moments = nullptr;  // (order + 1) per pixel, raw, added to
+  float* lower = nullptr;     // per pixel: min and max of the owned samples so far
+  float* upper = nullptr;
+
+  VISOPT_HD void operator()(int64_t pixel) const {
+    const MomentRay r = momentRay(camera, volume, pixel);
+    if (!r.hits()) return;
+    const int n = momentSampleCount(r, step);
+    const float dt = (r.t1 - r.t0) / float(n - 1);
+    int first = -1, last = -1;
+    for (int k = 0; k < n; ++k) {
+      const float z = momentSamplePoint(r, k, dt).z;
+      if (z >= ownedBegin && z < ownedEnd) {
+        if (first < 0) first = k;
+        last = k;
+      } else if (first >= 0) {
+        break;
+      }
+    }
+    if (first < 0) return;
+    float lo = lower[pixel], hi = upper[pixel];
+    double* c = moments + pixel * (order + 1);
+    const int pieceEnd = last + 1 < n ? last + 1 : last;
+    if (pieceEnd > first) {
+      addRayMoments(r, n, first, pieceEnd, last, order, density, c, lo, hi);
+    } else {  // the ray's last sample alone: no segment, only the bounds
+      const float v = density(momentSamplePoint(r, first, dt));
+      const float sv = v < 0.f ? 0.f : (v > 1.f ? 1.f : v);
+      lo = sv < lo ? sv : lo;
+      hi = sv > hi ? sv : hi;
+    }
+    lower[pixel] = lo;
+    upper[pixel] = hi;
   }
 };
 

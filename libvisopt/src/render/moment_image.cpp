@@ -103,6 +103,48 @@ std::vector<uint64_t> MomentImage::offsets() const {
   return out;
 }
 
+namespace {
+
+// §3.5's per-pixel counts and the stored form of `pixels` pixels, from their moments rescaled by
+// Eq. 5 (`dense`, order + 1 per pixel) and their bounds.
+MomentPixels countAndPack(const DeviceBuffer<float>& dense, const DeviceBuffer<float>& lower,
+                          const DeviceBuffer<float>& upper, size_t pixels,
+                          const MomentImageSettings& settings, double* countMs) {
+  const int stride = settings.moments + 1;
+  DeviceBuffer<uint8_t> counts(std::max<size_t>(pixels, 1));
+  const auto t1 = std::chrono::steady_clock::now();
+  exec::parallelFor("moments: count", int64_t(pixels),
+                    MomentCount{dense.data(), lower.data(), upper.data(), settings.moments,
+                                double(settings.errorThreshold), counts.data()});
+  if (countMs) *countMs += msSince(t1);
+  MomentPixels out;
+  out.counts.assign(counts.data(), counts.data() + pixels);
+  out.lower.assign(lower.data(), lower.data() + pixels);
+  out.upper.assign(upper.data(), upper.data() + pixels);
+  size_t stored = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    stored += out.counts[p];
+    if (out.counts[p] == 0) out.lower[p] = out.upper[p] = 0.f;
+  }
+  out.moments.reserve(stored);
+  for (size_t p = 0; p < pixels; ++p)
+    out.moments.insert(out.moments.end(), dense.data() + p * stride,
+                       dense.data() + p * stride + out.counts[p]);
+  return out;
+}
+
+void fillStats(const MomentImage& image, int64_t samplesTaken, double countMs,
+               MomentGenerationStats* stats) {
+  if (!stats) return;
+  int64_t hit = 0;
+  for (uint8_t c : image.counts) hit += c > 0;
+  stats->countMs = countMs;
+  stats->samples = samplesTaken;
+  stats->meanMoments = hit > 0 ? double(image.moments.size()) / double(hit) : 0.0;
+}
+
+}  // namespace
+
 MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
                                 const MomentImageSettings& settings, MomentGenerationStats* stats) {
   checkMomentImageSettings(settings);
@@ -112,7 +154,6 @@ MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
   const int stride = settings.moments + 1;
   DeviceBuffer<float> dense(pixels * size_t(stride)), lower(pixels), upper(pixels);
   DeviceBuffer<int> samples(pixels);
-  DeviceBuffer<uint8_t> counts(pixels);
 
   const auto t0 = std::chrono::steady_clock::now();
   MomentGeneration gen;
@@ -129,37 +170,12 @@ MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
   exec::parallelFor("moments: generate", int64_t(pixels), gen);
   const double marchMs = msSince(t0);
 
-  const auto t1 = std::chrono::steady_clock::now();
-  exec::parallelFor("moments: count", int64_t(pixels),
-                    MomentCount{dense.data(), lower.data(), upper.data(), settings.moments,
-                                double(settings.errorThreshold), counts.data()});
-  const double countMs = msSince(t1);
-
-  MomentImage out;
-  out.width = settings.width;
-  out.height = settings.height;
-  out.order = settings.moments;
-  out.camera = camera;
-  out.grid = grid;
-  out.valueMin = volume.valueMin;
-  out.valueMax = volume.valueMax;
-  out.boundsMargin = settings.boundsMargin;
-  out.errorThreshold = settings.errorThreshold;
-  out.stepVoxels = settings.stepVoxels;
-  out.counts.assign(counts.data(), counts.data() + pixels);
-  out.lower.assign(lower.data(), lower.data() + pixels);
-  out.upper.assign(upper.data(), upper.data() + pixels);
-  int64_t hit = 0, stored = 0, taken = 0;
-  for (size_t p = 0; p < pixels; ++p) {
-    stored += out.counts[p];
-    hit += out.counts[p] > 0;
-    taken += samples[p];
-    if (out.counts[p] == 0) out.lower[p] = out.upper[p] = 0.f;
-  }
-  out.moments.reserve(size_t(stored));
-  for (size_t p = 0; p < pixels; ++p)
-    out.moments.insert(out.moments.end(), dense.data() + p * stride,
-                       dense.data() + p * stride + out.counts[p]);
+  int64_t taken = 0;
+  for (size_t p = 0; p < pixels; ++p) taken += samples[p];
+  double countMs = 0.0;
+  MomentImage out = momentImageOf(countAndPack(dense, lower, upper, pixels, settings, &countMs),
+                                  grid, camera, settings, volume.valueMin, volume.valueMax);
+  fillStats(out, taken, countMs, stats);
   if (settings.uncertaintyQuantile > 0.f) {
     const auto t2 = std::chrono::steady_clock::now();
     const std::vector<uint64_t> offsets = out.offsets();
@@ -175,11 +191,158 @@ MomentImage generateMomentImage(const Volume& volume, const Camera& camera,
     out.uncertainty.assign(error.data(), error.data() + pixels);
     if (stats) stats->uncertaintyMs = msSince(t2);
   }
+  if (stats) stats->marchMs = marchMs;
+  return out;
+}
+
+MomentPartials emptyMomentPartials(const MomentImageSettings& settings) {
+  checkMomentImageSettings(settings);
+  MomentPartials p;
+  p.width = settings.width;
+  p.height = settings.height;
+  p.order = settings.moments;
+  const size_t pixels = size_t(p.width) * size_t(p.height);
+  p.moments.assign(pixels * size_t(p.order + 1), 0.0);
+  p.lower.assign(pixels, 1e30f);
+  p.upper.assign(pixels, -1e30f);
+  return p;
+}
+
+int momentSlabHalo(const MomentImageSettings& settings) {
+  // A slab's piece ends one step past its last sample: at most stepVoxels slices along z
+  // (the step is stepVoxels times the smallest spacing), and the trilinear sample there reads
+  // the slice above.
+  return int(std::ceil(settings.stepVoxels)) + 1;
+}
+
+void addMomentSlab(MomentPartials& partials, const Field3D& slab, int slabFirst, int ownedBegin,
+                   int ownedEnd, const GridSpec& grid, const Camera& camera,
+                   const MomentImageSettings& settings, double* marchMs) {
+  checkMomentImageSettings(settings);
+  checkCamera(camera, grid.worldBounds(), "moment image camera");
+  if (partials.width != settings.width || partials.height != settings.height ||
+      partials.order != settings.moments)
+    throw Error(ErrorKind::Usage, "moment partials were made for other settings");
+  const glm::ivec3 dims = grid.dims, sd = slab.grid().dims;
+  if (!(0 <= ownedBegin && ownedBegin < ownedEnd && ownedEnd <= dims.z))
+    throw Error(ErrorKind::Usage, "a moment slab must own slices within 0.." +
+                                      std::to_string(dims.z) + ", got " +
+                                      std::to_string(ownedBegin) + ".." + std::to_string(ownedEnd));
+  const int halo = momentSlabHalo(settings);
+  const int need0 = std::max(0, ownedBegin - halo), need1 = std::min(dims.z, ownedEnd + halo);
+  if (sd.x != dims.x || sd.y != dims.y || slabFirst > need0 || slabFirst + sd.z < need1)
+    throw Error(ErrorKind::Usage, "a moment slab owning slices " + std::to_string(ownedBegin) +
+                                      ".." + std::to_string(ownedEnd) + " must hold slices " +
+                                      std::to_string(need0) + ".." + std::to_string(need1));
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t pixels = size_t(settings.width) * size_t(settings.height);
+  const int stride = settings.moments + 1;
+  DeviceBuffer<double> moments(pixels * size_t(stride));
+  DeviceBuffer<float> lower(pixels), upper(pixels);
+  std::copy(partials.moments.begin(), partials.moments.end(), moments.data());
+  std::copy(partials.lower.begin(), partials.lower.end(), lower.data());
+  std::copy(partials.upper.begin(), partials.upper.end(), upper.data());
+  MomentSlabGeneration gen;
+  gen.camera = cameraMap(camera, settings.width, settings.height, grid);
+  gen.volume = GridMap(grid);
+  gen.density = SlabDensity{FieldView(slab), dims, slabFirst};
+  gen.ownedBegin = ownedBegin == 0 ? -1e30f : float(ownedBegin);
+  gen.ownedEnd = ownedEnd == dims.z ? 1e30f : float(ownedEnd);
+  gen.order = settings.moments;
+  gen.step = settings.stepVoxels * grid.minSpacing();
+  gen.moments = moments.data();
+  gen.lower = lower.data();
+  gen.upper = upper.data();
+  exec::parallelFor("moments: generate slab", int64_t(pixels), gen);
+  std::copy(moments.data(), moments.data() + moments.size(), partials.moments.begin());
+  std::copy(lower.data(), lower.data() + pixels, partials.lower.begin());
+  std::copy(upper.data(), upper.data() + pixels, partials.upper.begin());
+  if (marchMs) *marchMs += msSince(t0);
+}
+
+void mergeMomentPartials(MomentPartials& into, const MomentPartials& other) {
+  if (into.width != other.width || into.height != other.height || into.order != other.order)
+    throw Error(ErrorKind::Usage, "moment partials of different images cannot be merged");
+  for (size_t i = 0; i < into.moments.size(); ++i) into.moments[i] += other.moments[i];
+  for (size_t p = 0; p < into.lower.size(); ++p) {
+    into.lower[p] = std::min(into.lower[p], other.lower[p]);
+    into.upper[p] = std::max(into.upper[p], other.upper[p]);
+  }
+}
+
+MomentPixels finishMomentPixels(std::span<const double> moments, std::span<const float> lower,
+                                std::span<const float> upper, const MomentImageSettings& settings,
+                                double* countMs) {
+  checkMomentImageSettings(settings);
+  const size_t pixels = lower.size();
+  const int stride = settings.moments + 1;
+  if (upper.size() != pixels || moments.size() != pixels * size_t(stride))
+    throw Error(ErrorKind::Usage, "moment partials of " + std::to_string(pixels) +
+                                      " pixels need as many bounds and order + 1 moments each");
+  DeviceBuffer<float> dense(std::max<size_t>(pixels * size_t(stride), 1)),
+      lo(std::max<size_t>(pixels, 1)), hi(std::max<size_t>(pixels, 1));
+  for (size_t p = 0; p < pixels; ++p) {
+    float* out = dense.data() + p * size_t(stride);
+    if (!(lower[p] <= upper[p])) {  // no slab had a sample: the ray misses the volume
+      std::fill(out, out + stride, 0.f);
+      lo[p] = 1.f;
+      hi[p] = 0.f;
+      continue;
+    }
+    MomentGeneration::rescaleMoments(moments.data() + p * size_t(stride), settings.moments,
+                                     lower[p], upper[p], settings.boundsMargin, out, lo[p], hi[p]);
+  }
+  return countAndPack(dense, lo, hi, pixels, settings, countMs);
+}
+
+MomentImage momentImageOf(MomentPixels pixels, const GridSpec& grid, const Camera& camera,
+                          const MomentImageSettings& settings, double valueMin, double valueMax) {
+  const size_t n = size_t(settings.width) * size_t(settings.height);
+  if (pixels.counts.size() != n || pixels.lower.size() != n || pixels.upper.size() != n)
+    throw Error(ErrorKind::Usage, "a moment image of " + std::to_string(settings.width) + "x" +
+                                      std::to_string(settings.height) + " needs " +
+                                      std::to_string(n) + " finished pixels");
+  MomentImage out;
+  out.width = settings.width;
+  out.height = settings.height;
+  out.order = settings.moments;
+  out.camera = camera;
+  out.grid = grid;
+  out.valueMin = valueMin;
+  out.valueMax = valueMax;
+  out.boundsMargin = settings.boundsMargin;
+  out.errorThreshold = settings.errorThreshold;
+  out.stepVoxels = settings.stepVoxels;
+  out.counts = std::move(pixels.counts);
+  out.lower = std::move(pixels.lower);
+  out.upper = std::move(pixels.upper);
+  out.moments = std::move(pixels.moments);
+  return out;
+}
+
+MomentImage finishMomentImage(const MomentPartials& total, const GridSpec& grid,
+                              const Camera& camera, const MomentImageSettings& settings,
+                              double valueMin, double valueMax, MomentGenerationStats* stats) {
+  checkMomentImageSettings(settings);
+  if (settings.uncertaintyQuantile > 0.f)
+    throw Error(ErrorKind::Usage,
+                "the uncertainty (§4.1) needs each whole ray: distributed generation does not "
+                "compute it");
+  if (total.width != settings.width || total.height != settings.height ||
+      total.order != settings.moments)
+    throw Error(ErrorKind::Usage, "moment partials were made for other settings");
+  double countMs = 0.0;
+  MomentImage out =
+      momentImageOf(finishMomentPixels(total.moments, total.lower, total.upper, settings, &countMs),
+                    grid, camera, settings, valueMin, valueMax);
   if (stats) {
-    stats->marchMs = marchMs;
-    stats->countMs = countMs;
-    stats->samples = taken;
-    stats->meanMoments = hit > 0 ? double(stored) / double(hit) : 0.0;
+    const FrustumMap map = cameraMap(camera, settings.width, settings.height, grid);
+    const GridMap volume(grid);
+    const float step = settings.stepVoxels * grid.minSpacing();
+    int64_t taken = 0;
+    for (size_t p = 0; p < out.pixelCount(); ++p)
+      if (out.counts[p] > 0) taken += momentSampleCount(momentRay(map, volume, int64_t(p)), step);
+    fillStats(out, taken, countMs, stats);
   }
   return out;
 }

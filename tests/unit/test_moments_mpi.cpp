@@ -35,8 +35,8 @@ std::string tmp(const std::string& name) {
 int runTool(int ranks, const std::string& args, const std::string& log) {
   setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
   setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-  const std::string cmd = kMpiexec + " --oversubscribe --bind-to none -n " + std::to_string(ranks) + " " + kTool +
-                          " generate " + args + " > " + log + " 2>&1";
+  const std::string cmd = kMpiexec + " --oversubscribe --bind-to none -n " + std::to_string(ranks) +
+                          " " + kTool + " generate " + args + " > " + log + " 2>&1";
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }

@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 
+#include "moment_image_checks.h"
 #include "visopt/error.h"
 #include "visopt/moment_image.h"
 #include "visopt/scenes.h"
@@ -48,22 +49,6 @@ MomentImage fromSlabs(const Volume& v, const Camera& cam, const MomentImageSetti
   return finishMomentImage(total, v.grid(), cam, s, v.valueMin, v.valueMax);
 }
 
-void expectSameImage(const MomentImage& a, const MomentImage& b, const std::string& what) {
-  ASSERT_EQ(a.pixelCount(), b.pixelCount()) << what;
-  size_t countsDiffer = 0;
-  for (size_t p = 0; p < a.pixelCount(); ++p) countsDiffer += a.counts[p] != b.counts[p];
-  ASSERT_EQ(countsDiffer, 0u) << what << ": pixels whose moment counts differ";
-  EXPECT_EQ(a.lower, b.lower) << what << ": the bounds are min and max, exact";
-  EXPECT_EQ(a.upper, b.upper) << what;
-  ASSERT_EQ(a.moments.size(), b.moments.size()) << what;
-  double worst = 0.0;
-  for (size_t i = 0; i < a.moments.size(); ++i)
-    worst = std::max(worst, double(std::abs(a.moments[i] - b.moments[i])));
-  EXPECT_LE(worst, 1e-6) << what;
-  EXPECT_EQ(a.valueMin, b.valueMin);
-  EXPECT_EQ(a.valueMax, b.valueMax);
-}
-
 TEST(MomentSlabs, SlabsInAnyOrderGiveTheWholeVolumesImage) {
   for (const char* name : {"marschner-lobb", "shepp-logan"}) {
     const BuiltinScene sc = makeBuiltinScene(name, 40, Precision::FP32);
@@ -85,7 +70,7 @@ TEST(MomentSlabs, SlabsInAnyOrderGiveTheWholeVolumesImage) {
           const std::string what = std::string(name) + " el " + std::to_string(int(el)) +
                                    " slabs " + std::to_string(cuts.size() + 1) +
                                    (reversed ? " reversed" : "");
-          expectSameImage(fromSlabs(v, cam, s, cuts, reversed), whole, what);
+          testing::expectSameMomentImage(fromSlabs(v, cam, s, cuts, reversed), whole, what);
         }
       }
     }
@@ -103,8 +88,8 @@ TEST(MomentSlabs, OneSlabPerSliceAndACoarseStepStillAddUp) {
   const Camera cam = Camera::orbitBounds(v.grid().worldBounds(), 10.f, 35.f, 2.5f);
   std::vector<int> cuts;
   for (int z = 1; z < v.grid().dims.z; ++z) cuts.push_back(z);
-  expectSameImage(fromSlabs(v, cam, s, cuts, false), generateMomentImage(v, cam, s),
-                  "a slab per slice");
+  testing::expectSameMomentImage(fromSlabs(v, cam, s, cuts, false), generateMomentImage(v, cam, s),
+                                 "a slab per slice");
 }
 
 TEST(MomentSlabs, ASlabMissingItsHaloOrAnUncertaintyIsRefused) {

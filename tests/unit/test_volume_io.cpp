@@ -27,6 +27,7 @@
 #include "visopt/error.h"
 #include "visopt/memory_ledger.h"
 #include "visopt/render_settings.h"
+#include "visopt/value_normalization.h"
 #include "visopt/volume_io.h"
 
 namespace fs = std::filesystem;
@@ -1134,4 +1135,35 @@ TEST(VolumeIoRegression, LibFuzzerFindingsAreRefusedOrRender) {
     }
   }
   EXPECT_GE(files, 10);
+}
+
+// The normalisation (value - lo) / (hi - lo), clamped, against its closed form on ranges where
+// the formula as written breaks in double: a subnormal span, whose reciprocal overflows (0 * inf
+// was NaN: the fuzz finding float64-range-overflows.inr), and a span that itself overflows.
+TEST(ValueNormalization, MatchesTheClosedFormOnEveryFiniteRange) {
+  const ValueNormalization plain(-100.0, 300.0);
+  EXPECT_FLOAT_EQ(plain(-100.0), 0.f);
+  EXPECT_FLOAT_EQ(plain(0.0), 0.25f);
+  EXPECT_FLOAT_EQ(plain(300.0), 1.f);
+  EXPECT_FLOAT_EQ(plain(-1e9), 0.f);  // clamped below and above
+  EXPECT_FLOAT_EQ(plain(1e9), 1.f);
+
+  const double tiny = 4 * std::numeric_limits<double>::denorm_min();
+  ASSERT_FALSE(std::isfinite(1.0 / tiny));
+  const ValueNormalization subnormal(0.0, tiny);
+  EXPECT_FLOAT_EQ(subnormal(0.0), 0.f);
+  EXPECT_FLOAT_EQ(subnormal(tiny / 2), 0.5f);
+  EXPECT_FLOAT_EQ(subnormal(tiny), 1.f);
+
+  const double big = std::numeric_limits<double>::max();
+  ASSERT_FALSE(std::isfinite(big - -big));
+  const ValueNormalization huge(-big, big);
+  EXPECT_FLOAT_EQ(huge(-big), 0.f);
+  EXPECT_FLOAT_EQ(huge(0.0), 0.5f);
+  EXPECT_FLOAT_EQ(huge(big / 2), 0.75f);
+  EXPECT_FLOAT_EQ(huge(big), 1.f);
+
+  EXPECT_EQ(plain(std::nan("")), 0.f);  // never a NaN in a field
+  EXPECT_EQ(huge(std::nan("")), 0.f);
+  EXPECT_EQ(ValueNormalization(5.0, 5.0)(5.0), 0.f);  // one value: no range to spread over
 }

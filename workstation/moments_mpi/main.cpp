@@ -29,6 +29,7 @@
 #include "visopt/error.h"
 #include "visopt/moment_image.h"
 #include "visopt/scenes.h"
+#include "visopt/value_normalization.h"
 #include "visopt/volume_slabs.h"
 
 namespace {
@@ -117,10 +118,9 @@ Field3D normalisedSlab(const Source& src, int z0, int z1, double lo, double hi) 
     for (size_t i = 0; i < v.size(); ++i) slab.set(i, float(v[i]));
     return slab;
   }
-  // volume_io.cpp's normalisation, so that the slab equals readVolume's field.
-  const double scale = hi > lo ? 1.0 / (hi - lo) : 0.0;
-  for (size_t i = 0; i < v.size(); ++i)
-    slab.set(i, float(std::clamp((v[i] - lo) * scale, 0.0, 1.0)));
+  // readVolume's normalisation, so that the slab equals its field.
+  const ValueNormalization normalize(lo, hi);
+  for (size_t i = 0; i < v.size(); ++i) slab.set(i, normalize(v[i]));
   return slab;
 }
 

@@ -11,6 +11,7 @@
 #include "io/file_util.h"
 #include "io/volume_source.h"
 #include "visopt/error.h"
+#include "visopt/value_normalization.h"
 #include "visopt/volume_io.h"
 
 namespace visopt {
@@ -91,14 +92,13 @@ void checkValues(const std::string& path, const Stats& stats, size_t count) {
 
 void normalizeInto(const io::ScalarData& s, double lo, double hi, Field3D& field) {
   FieldView view(field);
-  const double scale = hi > lo ? 1.0 / (hi - lo) : 0.0;
+  const ValueNormalization normalize(lo, hi);
   io::visitScalarType(s.type, [&](auto zero) {
     using T = decltype(zero);
     const T* data = static_cast<const T*>(s.data);
     const double slope = s.slope, intercept = s.intercept;
     exec::parallelFor("io.normalize", int64_t(s.count), [=](int64_t i) {
-      const double v = double(data[i]) * slope + intercept;
-      view.store(size_t(i), float(std::clamp((v - lo) * scale, 0.0, 1.0)));
+      view.store(size_t(i), normalize(double(data[i]) * slope + intercept));
     });
   });
 }

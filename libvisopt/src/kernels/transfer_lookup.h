@@ -5,6 +5,7 @@
 #include <glm/glm.hpp>
 
 #include "core/hd.h"
+#include "core/min_max.h"
 
 namespace visopt {
 
@@ -20,7 +21,8 @@ struct TransferLookup {
 
   VISOPT_HD Entry locate(float t) const {
     Entry e;
-    float x = glm::clamp(t, 0.f, 1.f) * float(size - 1);
+    // minOf/maxOf, not glm::clamp: a NaN t becomes entry 0 instead of an undefined int(NaN).
+    const float x = minOf(maxOf(t, 0.f), 1.f) * float(size - 1);
     e.i0 = int(x);
     e.i1 = e.i0 + 1 < size ? e.i0 + 1 : size - 1;
     e.f = x - float(e.i0);

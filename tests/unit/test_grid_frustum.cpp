@@ -59,10 +59,12 @@ TEST(Camera, OrbitConventions) {
 TEST(FrustumGrid, CameraCentreRayAndDepthByHand) {
   Camera cam = Camera::orbit({0, 0, 0}, 0.f, 0.f, 10.f);  // eye (0,-10,0), looking along +y
   cam.fovYDegrees = 90.f;
-  Bounds b{{-1, -1, -1}, {1, 1, 1}};  // bounding-sphere radius sqrt(3)
+  Bounds b{{-1, -1, -1}, {1, 1, 1}};
   FrustumGrid f = FrustumGrid::forCamera(cam, 4, 2, b, 8, 0.1f);
-  EXPECT_NEAR(f.sNear, 10.f - std::sqrt(3.f), 1e-5f);
-  EXPECT_NEAR(f.sFar, 10.f + std::sqrt(3.f), 1e-5f);
+  // Depth from the box's nearest face (y = -1, 9 away) to its farthest corners (11, ±1, ±1),
+  // not the bounding sphere's 10 ± sqrt(3).
+  EXPECT_NEAR(f.sNear, 9.f, 1e-5f);
+  EXPECT_NEAR(f.sFar, std::sqrt(123.f), 1e-5f);
   EXPECT_NEAR(f.tanHalfFovY, 1.f, 1e-6f);
   EXPECT_NEAR(f.tanHalfFovX, 2.f, 1e-6f);
   // The origin is on the optical axis, between pixel centres 1 and 2 (x) and 0 and 1 (y),
@@ -116,6 +118,37 @@ TEST(FrustumGrid, LightFrustumContainsTheVolume) {
   FrustumGrid inside = FrustumGrid::forLight(light, b, {16, 16, 0}, 0.1f);
   EXPECT_TRUE(std::isfinite(inside.tanHalfFovX));
   EXPECT_GT(inside.sFar, inside.sNear);
+}
+
+// The depth range is the box's own: every point of the box lies in it (no sample of the volume is
+// cut off), and it is tight at both ends (a point of the box at sNear and at sFar), from a few
+// views of a flat box, and from an eye inside the box.
+TEST(FrustumGrid, DepthRangeIsTheBoxsOwn) {
+  const Bounds b{{-1.2f, -1.f, -0.4f}, {1.2f, 1.f, 0.4f}};
+  for (const glm::vec3 angles : {glm::vec3(0, 0, 5), glm::vec3(37, 21, 4), glm::vec3(90, 80, 3),
+                                 glm::vec3(200, -30, 6), glm::vec3(10, 5, 0.2f)}) {
+    const Camera cam = Camera::orbit({0.1f, 0.f, 0.f}, angles.x, angles.y, angles.z);
+    const FrustumGrid f = FrustumGrid::forCamera(cam, 16, 16, b, 0, 0.02f);
+    float lo = 1e30f, hi = 0.f;
+    for (int n = 0; n < 21 * 21 * 21; ++n) {  // a lattice of 21^3 points of the box
+      const glm::vec3 t(float(n % 21) / 20.f, float((n / 21) % 21) / 20.f, float(n / 441) / 20.f);
+      const float s = glm::length(b.lo + (b.hi - b.lo) * t - cam.eye);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    const bool inside =
+        glm::all(glm::greaterThan(cam.eye, b.lo)) && glm::all(glm::lessThan(cam.eye, b.hi));
+    EXPECT_LE(f.sNear, lo + 1e-5f) << angles.x;
+    EXPECT_GE(f.sFar, hi - 1e-5f) << angles.x;
+    EXPECT_NEAR(f.sFar, hi, 1e-4f) << angles.x;  // a corner is on the lattice
+    if (!inside) {
+      EXPECT_NEAR(f.sNear, lo, 0.15f) << angles.x;  // the lattice's point nearest the eye
+    } else {
+      EXPECT_LT(f.sNear, 1e-3f);
+    }
+    // Half a voxel per cell over the box's depth, not the sphere's 2r.
+    EXPECT_EQ(f.dims.z, int(std::ceil((f.sFar - f.sNear) / 0.01f)));
+  }
 }
 
 TEST(FrustumGrid, RejectsDegenerateCameras) {

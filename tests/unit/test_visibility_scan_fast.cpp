@@ -181,7 +181,9 @@ void expectSame(const Result& ref, const Result& fast, const Case& c, const char
     ASSERT_NEAR(ref.d[i], fast.d[i], rel * scale) << "cell " << i;
     nonzero += ref.d[i] != 0.f;
   }
-  EXPECT_GT(nonzero, ref.d.size() / 20);  // the rays do cross the volume
+  // The rays do cross the volume. The fewest nonzero d are in the light cases with two surfaces,
+  // 4.8 % of the cells (rays that miss the box, or cells behind its surfaces, hold 0).
+  EXPECT_GT(nonzero, ref.d.size() / 25);
   ASSERT_EQ(ref.behindMax.size(), fast.behindMax.size());
   for (size_t i = 0; i < ref.behindMax.size(); ++i)
     ASSERT_NEAR(ref.behindMax[i], fast.behindMax[i], rel) << "cell " << i;

@@ -34,13 +34,13 @@ struct FrustumGrid {
   // Unit direction of the ray through continuous pixel coordinates (px, py).
   glm::vec3 rayDirection(float px, float py) const;
 
-  // The camera's frustum at the given image size; [sNear, sFar] is clipped to `bounds`'s
-  // bounding sphere; depthCells == 0 picks one cell per half of the smallest voxel spacing
-  // along the bounds' diagonal (`voxelSize`), capped at 1024.
+  // The camera's frustum at the given image size; [sNear, sFar] is clipped to the distances
+  // from the eye to the points of `bounds`; depthCells == 0 picks one cell per half of the smallest
+  // voxel spacing along the bounds' diagonal (`voxelSize`), capped at 1024.
   static FrustumGrid forCamera(const Camera& camera, int width, int height, const Bounds& bounds,
                                int depthCells, float voxelSize);
   // A square frustum from the point light towards `bounds`, wide enough to contain the bounding
-  // sphere (at most 160° when the light is inside it).
+  // sphere (at most 160° when the light is inside it), its depth clipped as forCamera's.
   static FrustumGrid forLight(const PointLight& light, const Bounds& bounds, glm::ivec3 dims,
                               float voxelSize);
 };

@@ -18,11 +18,21 @@ int autoDepthCells(float sNear, float sFar, float voxelSize) {
   return std::clamp(n, 2, 1024);
 }
 
-void clipToSphere(FrustumGrid& f, const Bounds& bounds) {
-  float radius = std::max(0.5f * glm::length(bounds.size()), 1e-6f);
-  float d = glm::length(bounds.center() - f.eye);
-  f.sNear = std::max(d - radius, 1e-4f * radius);
-  f.sFar = d + radius;
+// [sNear, sFar] holds every distance from the eye to a point of the box: the nearest is the
+// eye's distance to the box (0 inside it), the farthest one of its corners (distance is convex).
+// Tighter than the bounding sphere's [d - r, d + r] for every box that is not a point: on a flat
+// CT (256 x 256 x 108 voxels) seen from the side, about a third fewer depth cells.
+void clipToBox(FrustumGrid& f, const Bounds& bounds) {
+  const float radius = std::max(0.5f * glm::length(bounds.size()), 1e-6f);
+  const glm::vec3 nearest = glm::clamp(f.eye, bounds.lo, bounds.hi);
+  float farthest = 0.f;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? bounds.hi.x : bounds.lo.x, (c & 2) ? bounds.hi.y : bounds.lo.y,
+                           (c & 4) ? bounds.hi.z : bounds.lo.z);
+    farthest = std::max(farthest, glm::length(corner - f.eye));
+  }
+  f.sNear = std::max(glm::length(nearest - f.eye), 1e-4f * radius);
+  f.sFar = std::max(farthest, f.sNear + 1e-4f * radius);
 }
 
 }  // namespace
@@ -54,7 +64,7 @@ FrustumGrid FrustumGrid::forCamera(const Camera& camera, int width, int height,
   f.up = glm::cross(f.right, f.forward);
   f.tanHalfFovY = std::tan(0.5f * camera.fovYDegrees * kDegToRad);
   f.tanHalfFovX = f.tanHalfFovY * static_cast<float>(width) / static_cast<float>(height);
-  clipToSphere(f, bounds);
+  clipToBox(f, bounds);
   f.dims = glm::ivec3(width, height,
                       depthCells > 0 ? depthCells : autoDepthCells(f.sNear, f.sFar, voxelSize));
   return f;
@@ -78,7 +88,7 @@ FrustumGrid FrustumGrid::forLight(const PointLight& light, const Bounds& bounds,
       d > radius * 1.0001f ? std::asin(std::min(radius / d, 1.f)) * 1.02f : 80.f * kDegToRad;
   half = std::min(half, 80.f * kDegToRad);
   f.tanHalfFovX = f.tanHalfFovY = std::tan(half);
-  clipToSphere(f, bounds);
+  clipToBox(f, bounds);
   f.dims =
       glm::ivec3(dims.x, dims.y, dims.z > 0 ? dims.z : autoDepthCells(f.sNear, f.sFar, voxelSize));
   return f;

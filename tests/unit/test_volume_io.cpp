@@ -23,6 +23,7 @@
 #include <glm/glm.hpp>
 
 #include "fuzz/smallest_render.h"
+#include "nifti_writer.h"
 #include "visopt/engine.h"
 #include "visopt/error.h"
 #include "visopt/memory_ledger.h"
@@ -180,41 +181,12 @@ std::string writeRawVolume(const std::string& dir, const std::string& type, cons
   return path;
 }
 
-// ---- NIfTI-1 header, written by hand (348 bytes + 4 extension bytes) --------------------------
-struct NiftiSpec {
-  int16_t datatype = 4, bitpix = 16;  // int16
-  float qfac = 1.f;
-  float quatern[3] = {0, 0, 0};
-  float qoffset[3] = {0, 0, 0};
-  int16_t qformCode = 1, sformCode = 0;
-  float srow[3][4] = {};
-  float sclSlope = 1.f, sclInter = 0.f;
-};
-
-std::string niftiHeader(const NiftiSpec& s) {
-  std::string h(352, '\0');
-  auto put = [&](size_t offset, auto value) {
-    std::memcpy(h.data() + offset, &value, sizeof(value));
-  };
-  put(0, int32_t(348));
-  const int16_t dim[8] = {3, NX, NY, NZ, 1, 1, 1, 1};
-  for (int i = 0; i < 8; ++i) put(40 + 2 * size_t(i), dim[i]);
-  put(70, s.datatype);
-  put(72, s.bitpix);
-  const float pixdim[8] = {s.qfac, kSpacing.x, kSpacing.y, kSpacing.z, 1, 1, 1, 1};
-  for (int i = 0; i < 8; ++i) put(76 + 4 * size_t(i), pixdim[i]);
-  put(108, 352.f);  // vox_offset
-  put(112, s.sclSlope);
-  put(116, s.sclInter);
-  put(123, char(2));  // xyzt_units: mm
-  put(252, s.qformCode);
-  put(254, s.sformCode);
-  for (int i = 0; i < 3; ++i) put(256 + 4 * size_t(i), s.quatern[i]);
-  for (int i = 0; i < 3; ++i) put(268 + 4 * size_t(i), s.qoffset[i]);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) put(280 + 16 * size_t(r) + 4 * size_t(c), s.srow[r][c]);
-  std::memcpy(h.data() + 344, "n+1\0", 4);
-  return h;
+// A NIfTI-1 header for the test volume's dimensions and spacing.
+test_files::NiftiSpec niftiSpec() {
+  test_files::NiftiSpec s;
+  s.dim[1] = NX, s.dim[2] = NY, s.dim[3] = NZ;
+  s.spacing[0] = kSpacing.x, s.spacing[1] = kSpacing.y, s.spacing[2] = kSpacing.z;
+  return s;
 }
 
 // For a file whose voxel (i,j,k) sits at world = A * (i,j,k) + b, checks that every voxel of
@@ -430,12 +402,12 @@ TEST(VolumeIoNrrd, DetachedGzip) {
 }
 
 TEST(VolumeIoNifti, QformRotationWithRescale) {
-  NiftiSpec s;
+  test_files::NiftiSpec s = niftiSpec();
   s.quatern[2] = std::sqrt(0.5f);  // 90 degrees about z: a = d = sqrt(1/2)
   s.qoffset[0] = 10, s.qoffset[1] = -20, s.qoffset[2] = 30;
   s.sclSlope = 2.f, s.sclInter = -3.f;
   std::string path = join(tmpDir(), "vol.nii");
-  writeBytes(path, niftiHeader(s) + toBytes(referenceValues<int16_t>()));
+  writeBytes(path, test_files::niftiHeader(s) + toBytes(referenceValues<int16_t>()));
   Volume v = readVolume(path, Precision::FP32);
   EXPECT_EQ(v.scalarType, "int16");
   expectGrid(v.grid(), {NX, NY, NZ}, kSpacing, kOrigin, kRotZ);
@@ -449,12 +421,12 @@ TEST(VolumeIoNifti, QformRotationWithRescale) {
 }
 
 TEST(VolumeIoNifti, QfacMinusOneKeepsWorldPositions) {
-  NiftiSpec s;
+  test_files::NiftiSpec s = niftiSpec();
   s.qfac = -1.f;
   s.quatern[2] = std::sqrt(0.5f);
   s.qoffset[0] = 10, s.qoffset[1] = -20, s.qoffset[2] = 30;
   std::string path = join(tmpDir(), "flip.nii");
-  writeBytes(path, niftiHeader(s) + toBytes(referenceValues<int16_t>()));
+  writeBytes(path, test_files::niftiHeader(s) + toBytes(referenceValues<int16_t>()));
   Volume v = readVolume(path, Precision::FP32);
   EXPECT_EQ(v.grid().dims, glm::ivec3(NX, NY, NZ));
   // File voxel (i,j,k) lies at R * diag(sx, sy, -sz) * (i,j,k) + qoffset.
@@ -465,14 +437,14 @@ TEST(VolumeIoNifti, QfacMinusOneKeepsWorldPositions) {
 }
 
 TEST(VolumeIoNifti, SformWithFlipTakesPrecedence) {
-  NiftiSpec s;
+  test_files::NiftiSpec s = niftiSpec();
   s.datatype = 16, s.bitpix = 32;  // float32
   s.qformCode = 0, s.sformCode = 2;
   // x flipped: i runs along -x; j along +y; k along +z.
   float m[3][4] = {{-kSpacing.x, 0, 0, 5}, {0, kSpacing.y, 0, 6}, {0, 0, kSpacing.z, -7}};
   std::memcpy(s.srow, m, sizeof(m));
   std::string path = join(tmpDir(), "sform.nii");
-  writeBytes(path, niftiHeader(s) + toBytes(referenceValues<float>()));
+  writeBytes(path, test_files::niftiHeader(s) + toBytes(referenceValues<float>()));
   Volume v = readVolume(path, Precision::FP32);
   EXPECT_EQ(v.scalarType, "float32");
   glm::mat3 flipX(glm::vec3(-1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(0, 0, 1));
@@ -813,13 +785,13 @@ TEST(VolumeIoBadInput, TruncatedAndLyingHeaders) {
                  full);
   expectReadBad(nrrd, "truncated");
   // NIfTI with data cut short.
-  NiftiSpec s;
+  test_files::NiftiSpec s = niftiSpec();
   std::string nii = join(dir, "cut.nii");
-  writeBytes(nii, niftiHeader(s) + full.substr(0, full.size() / 2));
+  writeBytes(nii, test_files::niftiHeader(s) + full.substr(0, full.size() / 2));
   expectReadBad(nii, "cut.nii");
   // NIfTI with the header cut.
   std::string hdr = join(dir, "hdr.nii");
-  writeBytes(hdr, niftiHeader(s).substr(0, 100));
+  writeBytes(hdr, test_files::niftiHeader(s).substr(0, 100));
   expectReadBad(hdr, "hdr.nii");
   // .vti cut in the middle of the data.
   std::ostringstream xml;
@@ -880,8 +852,8 @@ TEST(VolumeIoBadInput, CompressedStreamsAreCheckedToTheirEnd) {
   // 1000 x 1000 x 100 shorts (200 MB) from ~100 bytes: refused by the deflate bound.
   expectReadBad(nrrd("huge.nrrd", "1000 1000 100", good), "inflate to at most");
 
-  NiftiSpec spec;
-  const std::string niiBytes = niftiHeader(spec) + full;
+  test_files::NiftiSpec spec = niftiSpec();
+  const std::string niiBytes = test_files::niftiHeader(spec) + full;
   const std::string niiGood = gzipBytes(niiBytes, 31);
   writeBytes(join(dir, "good.nii.gz"), niiGood);
   EXPECT_NO_THROW((void)readVolume(join(dir, "good.nii.gz"), Precision::FP32));

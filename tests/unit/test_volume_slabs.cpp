@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "nifti_writer.h"
 #include "visopt/error.h"
 #include "visopt/volume_io.h"
 #include "visopt/volume_slabs.h"
@@ -87,44 +88,12 @@ std::string writeRaw(const std::string& dir, const std::string& name, const std:
   return path;
 }
 
-// ---- NIfTI-1 header, written by hand (348 bytes + 4 extension bytes), either byte order ------
-struct NiftiSpec {
-  int16_t datatype = 4, bitpix = 16;  // int16
-  float qfac = 1.f;
-  float quatern[3] = {0, 0, 0};
-  float qoffset[3] = {0, 0, 0};
-  int16_t qformCode = 1, sformCode = 0;
-  float srow[3][4] = {};
-  float sclSlope = 1.f, sclInter = 0.f;
-  int16_t dim[8] = {3, NX, NY, NZ, 1, 1, 1, 1};
-  bool bigEndian = false;
-};
-
-std::string niftiHeader(const NiftiSpec& s) {
-  std::string h(352, '\0');
-  auto put = [&](size_t offset, auto value) {
-    std::string b;
-    append(b, value, s.bigEndian);
-    std::memcpy(h.data() + offset, b.data(), b.size());
-  };
-  put(0, int32_t(348));
-  for (int i = 0; i < 8; ++i) put(40 + 2 * size_t(i), s.dim[i]);
-  put(70, s.datatype);
-  put(72, s.bitpix);
-  const float pixdim[8] = {s.qfac, 0.5f, 1.25f, 2.f, 1, 1, 1, 1};
-  for (int i = 0; i < 8; ++i) put(76 + 4 * size_t(i), pixdim[i]);
-  put(108, 352.f);  // vox_offset
-  put(112, s.sclSlope);
-  put(116, s.sclInter);
-  h[123] = char(2);  // xyzt_units: mm
-  put(252, s.qformCode);
-  put(254, s.sformCode);
-  for (int i = 0; i < 3; ++i) put(256 + 4 * size_t(i), s.quatern[i]);
-  for (int i = 0; i < 3; ++i) put(268 + 4 * size_t(i), s.qoffset[i]);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) put(280 + 16 * size_t(r) + 4 * size_t(c), s.srow[r][c]);
-  std::memcpy(h.data() + 344, "n+1\0", 4);
-  return h;
+// A NIfTI-1 header for the test volume's dimensions and spacing.
+test_files::NiftiSpec niftiSpec() {
+  test_files::NiftiSpec s;
+  s.dim[1] = NX, s.dim[2] = NY, s.dim[3] = NZ;
+  s.spacing[0] = 0.5f, s.spacing[1] = 1.25f, s.spacing[2] = 2.f;
+  return s;
 }
 
 using Split = std::vector<std::pair<int, int>>;
@@ -252,53 +221,54 @@ TEST(VolumeSlabs, MetaImageMhaAndMhd) {
 TEST(VolumeSlabs, NiftiRescaleQfacSformAndByteOrder) {
   const std::string dir = tmpDir();
   {  // qform rotation, non-identity scl_slope / scl_inter
-    NiftiSpec s;
+    test_files::NiftiSpec s = niftiSpec();
     s.quatern[2] = std::sqrt(0.5f);
     s.qoffset[0] = 10, s.qoffset[1] = -20, s.qoffset[2] = 30;
     s.sclSlope = 0.37f, s.sclInter = -12.5f;
     const std::string path = join(dir, "rescale.nii");
-    writeBytes(path, niftiHeader(s) + volumeBytes<int16_t>(false));
+    writeBytes(path, test_files::niftiHeader(s) + volumeBytes<int16_t>(false));
     expectSlabsMatchReadVolume(path, "nifti");
     const VolumeSlabReader reader(path);
     EXPECT_EQ(reader.readSlices(2, 3)[size_t(1 * NX + 4)],
               storedAt(4, 1, 2) * double(0.37f) + double(-12.5f));
   }
   {  // qfac -1: VTK reverses the slices; so must the slabs
-    NiftiSpec s;
+    test_files::NiftiSpec s = niftiSpec();
     s.qfac = -1.f;
     s.quatern[2] = std::sqrt(0.5f);
     s.qoffset[0] = 10, s.qoffset[1] = -20, s.qoffset[2] = 30;
     s.sclSlope = 2.f, s.sclInter = 3.f;
     const std::string path = join(dir, "qfac.nii");
-    writeBytes(path, niftiHeader(s) + volumeBytes<int16_t>(false));
+    writeBytes(path, test_files::niftiHeader(s) + volumeBytes<int16_t>(false));
     expectSlabsMatchReadVolume(path, "nifti");
     const VolumeSlabReader reader(path);
     EXPECT_EQ(reader.readSlices(0, 1)[0], storedAt(0, 0, NZ - 1) * 2.0 + 3.0);
   }
   {  // a reflecting sform (float32): reversed slices too
-    NiftiSpec s;
+    test_files::NiftiSpec s = niftiSpec();
     s.datatype = 16, s.bitpix = 32;
     s.qformCode = 0, s.sformCode = 2;
     float m[3][4] = {{-0.5f, 0, 0, 5}, {0, 1.25f, 0, 6}, {0, 0, 2.f, -7}};
     std::memcpy(s.srow, m, sizeof(m));
     const std::string path = join(dir, "sform.nii");
-    writeBytes(path, niftiHeader(s) + volumeBytes<float>(false, 0.173));
+    writeBytes(path, test_files::niftiHeader(s) + volumeBytes<float>(false, 0.173));
     expectSlabsMatchReadVolume(path, "nifti");
   }
   {  // big endian, uint16, with a rescale
-    NiftiSpec s;
+    test_files::NiftiSpec s = niftiSpec();
     s.bigEndian = true;
     s.datatype = 512;
     s.sclSlope = -1.5f, s.sclInter = 100.f;
     const std::string path = join(dir, "big.nii");
-    writeBytes(path, niftiHeader(s) + volumeBytes<uint16_t>(true));
+    writeBytes(path, test_files::niftiHeader(s) + volumeBytes<uint16_t>(true));
     expectSlabsMatchReadVolume(path, "nifti");
   }
   {  // a time series: the first frame, as readVolume
-    NiftiSpec s;
+    test_files::NiftiSpec s = niftiSpec();
     s.dim[0] = 4, s.dim[4] = 2;
     const std::string path = join(dir, "frames.nii");
-    writeBytes(path, niftiHeader(s) + volumeBytes<int16_t>(false) + volumeBytes<int16_t>(true));
+    writeBytes(path, test_files::niftiHeader(s) + volumeBytes<int16_t>(false) +
+                         volumeBytes<int16_t>(true));
     expectSlabsMatchReadVolume(path, "nifti");
   }
 }
@@ -315,8 +285,8 @@ TEST(VolumeSlabs, TruncatedDataFailsOnlyTheSlabsPastTheEnd) {
   const VolumeSlabReader reference(complete);
   std::ostringstream dims;
   dims << "NDims = 3\nDimSize = " << NX << " " << NY << " " << NZ << "\n";
-  NiftiSpec nifti;
-  writeBytes(join(dir, "cut.nii"), niftiHeader(nifti) + cut);
+  test_files::NiftiSpec nifti = niftiSpec();
+  writeBytes(join(dir, "cut.nii"), test_files::niftiHeader(nifti) + cut);
   writeBytes(join(dir, "cut.mha"),
              dims.str() + "ElementType = MET_SHORT\nElementDataFile = LOCAL\n" + cut);
   writeBytes(join(dir, "cut.data"), cut);
@@ -372,9 +342,9 @@ TEST(VolumeSlabs, AbsurdHeadersAreRefused) {
              "NDims = 3\nDimSize = 3000000000 2 2\nElementType = MET_UCHAR\n"
              "ElementDataFile = LOCAL\nxx");
   expectBadInput(open(mha), "axis.mha", "too large");
-  NiftiSpec s;
+  test_files::NiftiSpec s = niftiSpec();
   s.dim[2] = -5;
-  writeBytes(join(dir, "neg.nii"), niftiHeader(s) + data);
+  writeBytes(join(dir, "neg.nii"), test_files::niftiHeader(s) + data);
   expectBadInput(open(join(dir, "neg.nii")), "neg.nii", "dim[2]");
 
   // 1e13 voxels: more than memory holds, which a slab reader does not need, but the data is not

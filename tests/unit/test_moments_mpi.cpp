@@ -135,11 +135,15 @@ TEST_F(MomentsMpi, RanksReadingSlabsOfAFileUnderAMemoryLimitWriteTheSingleProces
         0)
         << slurp(log);
     expectSameImage(readMomentImage(out), reference, tag + " ranks");
+    const std::string report = slurp(log);
     if (!c.extra.empty()) {
-      const std::string report = slurp(log);
       EXPECT_NE(report.find("\"slabs\": 4"), std::string::npos)
           << "each rank's 13-14 slices read in slabs of 4:\n"
           << report;
+    } else if (c.ranks == 2) {
+      // Without a limit each share is read once, with its halo: [0, 13) + 2 and 2 + [13, 27).
+      EXPECT_NE(report.find("\"slices_read\": 15"), std::string::npos) << report;
+      EXPECT_NE(report.find("\"slices_read\": 16"), std::string::npos) << report;
     }
   }
 }

@@ -109,11 +109,13 @@ Share shareOf(int slices, int rank, int ranks) {
   return {int(int64_t(slices) * rank / ranks), int(int64_t(slices) * (rank + 1) / ranks)};
 }
 
-Field3D normalisedSlab(const Source& src, int z0, int z1, double lo, double hi) {
+// Slices [z0, z1) normalised as readVolume normalises the whole volume; `v` holds their values
+// as Source::read gives them.
+Field3D normalisedSlab(const Source& src, const std::vector<double>& v, int z0, int z1, double lo,
+                       double hi) {
   GridSpec g = src.grid();
   g.dims.z = z1 - z0;
   Field3D slab("moment slab", g, Precision::FP32);
-  const std::vector<double> v = src.read(z0, z1);
   if (src.scene) {  // already normalised
     for (size_t i = 0; i < v.size(); ++i) slab.set(i, float(v[i]));
     return slab;
@@ -214,17 +216,33 @@ int run(int rank, int ranks, Options& o, int threads) {
   }
   const Share share = shareOf(nz, rank, ranks);
 
+  // The slices a slab reads: its own and the halo on either side.
+  auto slabBegin = [&](int z) { return std::max(0, z - halo); };
+  auto slabEnd = [&](int z) { return std::min(nz, std::min(share.end, z + depth) + halo); };
+  // A share that is one slab is read once: the range pass reads it with its halo and keeps the
+  // values for the march (the halo's slices are other ranks' own, so they leave the range over
+  // all ranks as it is). A share of several slabs is read twice, as no more fits.
+  const bool oneSlab = share.end - share.begin <= depth;
+  std::vector<double> kept;
+  int slicesRead = 0;  // over both passes, for the report
+  auto read = [&](int z0, int z1) {
+    slicesRead += z1 - z0;
+    return src.read(z0, z1);
+  };
+
   // The value range over all ranks (files only; a scene's is its own).
   const auto tRange = Clock::now();
   Range mine;
   if (int code = collectively(rank, [&] {
         if (!src.file) return;
         for (int z = share.begin; z < share.end; z += depth) {
-          const std::vector<double> v = src.read(z, std::min(share.end, z + depth));
+          std::vector<double> v =
+              oneSlab ? read(slabBegin(z), slabEnd(z)) : read(z, std::min(share.end, z + depth));
           for (double x : v) {
             mine.lo = std::min(mine.lo, x);
             mine.hi = std::max(mine.hi, x);
           }
+          if (oneSlab) kept = std::move(v);
         }
       }))
     return code;
@@ -246,9 +264,11 @@ int run(int rank, int ranks, Options& o, int threads) {
         partials = emptyMomentPartials(o.settings);
         for (int z = share.begin; z < share.end; z += depth) {
           const int own1 = std::min(share.end, z + depth);
-          const int z0 = std::max(0, z - halo), z1 = std::min(nz, own1 + halo);
+          const int z0 = slabBegin(z), z1 = slabEnd(z);
           const auto tr = Clock::now();
-          const Field3D slab = normalisedSlab(src, z0, z1, valueMin, valueMax);
+          const std::vector<double> values = kept.empty() ? read(z0, z1) : std::move(kept);
+          kept = {};
+          const Field3D slab = normalisedSlab(src, values, z0, z1, valueMin, valueMax);
           readMs += msSince(tr);
           largestSlab = std::max(largestSlab, size_t(z1 - z0) * bytesPerSlice);
           addMomentSlab(partials, slab, z0, z, own1, grid, camera, o.settings, &marchMs);
@@ -357,9 +377,10 @@ int run(int rank, int ranks, Options& o, int threads) {
   const double countWallMs = msSince(tCount) - gatherMs;
 
   // Every rank's timings for the report.
-  const double times[4] = {readMs, marchMs, double(slabs), countMs};
-  std::vector<double> all(size_t(ranks) * 4);
-  MPI_Gather(times, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  constexpr int kReported = 5;
+  const double times[kReported] = {readMs, marchMs, double(slabs), countMs, double(slicesRead)};
+  std::vector<double> all(size_t(ranks) * kReported);
+  MPI_Gather(times, kReported, MPI_DOUBLE, all.data(), kReported, MPI_DOUBLE, 0, MPI_COMM_WORLD);
 
   return collectively(rank, [&] {
     if (rank != 0) return;
@@ -375,10 +396,11 @@ int run(int rank, int ranks, Options& o, int threads) {
       for (int r = 0; r < ranks; ++r)
         perRank.push_back({{"rank", r},
                            {"slices", {shareOf(nz, r, ranks).begin, shareOf(nz, r, ranks).end}},
-                           {"slabs", int(all[size_t(r) * 4 + 2])},
-                           {"read_ms", all[size_t(r) * 4]},
-                           {"march_ms", all[size_t(r) * 4 + 1]},
-                           {"count_ms", all[size_t(r) * 4 + 3]}});
+                           {"slabs", int(all[size_t(r) * kReported + 2])},
+                           {"slices_read", int(all[size_t(r) * kReported + 4])},
+                           {"read_ms", all[size_t(r) * kReported]},
+                           {"march_ms", all[size_t(r) * kReported + 1]},
+                           {"count_ms", all[size_t(r) * kReported + 3]}});
       const nlohmann::json d = {{"command", "moments-mpi generate"},
                                 {"input", src.name},
                                 {"ranks", ranks},

@@ -4,6 +4,7 @@
 // step, per scene and image size; the same-run STREAM probe gives the memory system's pace.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <map>
 #include <string>
 
@@ -55,6 +56,36 @@ void generate(benchmark::State& state, const Case& c, int size) {
   state.counters["ns_per_sample_march"] = march * 1e6 / double(samples);
 }
 
+// What a rank of visopt-moments-mpi runs (docs/moment-images.md, "Distributed generation"):
+// the volume cut into `slabs` slabs of whole slices, each copied out with its halo and added to
+// the partials, which are then finished. Against generate/ in the same run, the cost of cutting.
+void generateInSlabs(benchmark::State& state, const Case& c, int size, int slabs) {
+  const BuiltinScene& s = sceneOf(c);
+  const GridSpec& grid = s.volume.grid();
+  MomentImageSettings settings;
+  settings.width = settings.height = size;
+  const int nz = grid.dims.z, halo = momentSlabHalo(settings);
+  const size_t plane = size_t(grid.dims.x) * size_t(grid.dims.y);
+  double march = 0.0;
+  for (auto _ : state) {
+    MomentPartials partials = emptyMomentPartials(settings);
+    for (int k = 0; k < slabs; ++k) {
+      const int own0 = nz * k / slabs, own1 = nz * (k + 1) / slabs;
+      const int z0 = std::max(0, own0 - halo), z1 = std::min(nz, own1 + halo);
+      GridSpec g = grid;
+      g.dims.z = z1 - z0;
+      Field3D slab("slab", g, Precision::FP32);
+      for (size_t i = 0; i < slab.size(); ++i)
+        slab.set(i, s.volume.normalized.get(size_t(z0) * plane + i));
+      addMomentSlab(partials, slab, z0, own0, own1, grid, viewOf(s), settings, &march);
+    }
+    const MomentImage image = finishMomentImage(partials, grid, viewOf(s), settings,
+                                                s.volume.valueMin, s.volume.valueMax);
+    benchmark::DoNotOptimize(image.moments.data());
+  }
+  state.counters["march_ms"] = march / double(state.iterations());
+}
+
 void render(benchmark::State& state, const Case& c, int size, MomentReconstruction r,
             bool perSample = false) {
   const BuiltinScene& s = sceneOf(c);
@@ -94,6 +125,10 @@ int main(int argc, char** argv) {
       const std::string name = c.scene + "/" + std::to_string(size);
       benchmark::RegisterBenchmark(("generate/" + name).c_str(),
                                    [=](benchmark::State& st) { generate(st, c, size); })
+          ->UseRealTime()
+          ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("generate-in-8-slabs/" + name).c_str(),
+                                   [=](benchmark::State& st) { generateInSlabs(st, c, size, 8); })
           ->UseRealTime()
           ->Unit(benchmark::kMillisecond);
       for (MomentReconstruction r :
